@@ -1,0 +1,24 @@
+"""uvsym: marine-vehicle dynamics and fault-diagnosis observers, built symbolically in CasADi."""
+
+from uvsym import errors
+from uvsym.models import (
+    Model,
+    fixed_thrusters,
+    identifiability,
+    vectored_thrusters,
+    vehicle,
+    vehicle_names,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Model",
+    "__version__",
+    "errors",
+    "fixed_thrusters",
+    "identifiability",
+    "vectored_thrusters",
+    "vehicle",
+    "vehicle_names",
+]

@@ -1,0 +1,112 @@
+"""The ``uvsym`` command: list and inspect vehicles, build derivation reports."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from importlib.metadata import entry_points
+from pathlib import Path
+
+import numpy as np
+
+from uvsym import __version__
+from uvsym.errors import UnknownNameError, UvsymError
+from uvsym.models import VEHICLES, vehicle
+
+__all__ = ["main", "derivations"]
+
+DERIVATION_GROUP = "uvsym.derivations"
+
+
+def derivations() -> dict:
+    """Installed derivations: name -> entry point of a ``build(out_dir, progress)`` function."""
+    return {ep.name: ep for ep in sorted(entry_points(group=DERIVATION_GROUP), key=lambda ep: ep.name)}
+
+
+def _table(rows: list[list[str]], header: list[str]) -> str:
+    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
+    line = lambda r: "  ".join(str(c).ljust(w) for c, w in zip(r, widths)).rstrip()  # noqa: E731
+    return "\n".join([line(header), line(["-" * w for w in widths]), *map(line, rows)])
+
+
+def _cmd_models(args) -> int:
+    if args.action == "show":
+        if not args.name:
+            raise UnknownNameError(f"'uvsym models show' needs a vehicle name; known: {', '.join(VEHICLES)}")
+        model = vehicle(args.name)
+        summary = model.summary()
+        if args.json:
+            print(json.dumps(summary, indent=2))
+            return 0
+        print(f"{model.name}: {model.description}")
+        print(f"{model.dof} DOF; states x = [eta; nu] = {', '.join(f'{l} ({u})' for l, u in zip(model.state_labels, model.state_units))}")
+        print("inputs: " + ", ".join(f"{i['label']} ({i['unit']}, {i['min']:.6g} .. {i['max']:.6g})" for i in summary["inputs"]))
+        print("equations: M (nu_dot - nu_c_dot) + h(eta, nu) = tau(eta, nu, u);  h = " + " + ".join(model.term_names))
+        print(f"nu_dot: {model.nu_dot.n_instructions()} SX instructions\n")
+        print("M =\n" + np.array2string(model.M, precision=6, suppress_small=True, max_line_width=140) + "\n")
+        rows = [[name, _format_value(p.value), p.unit, p.description] for name, p in model.parameters.items()]
+        print(_table(rows, ["parameter", "value", "unit", "meaning"]))
+        return 0
+    listing = [{"name": name, "description": description, "dof": vehicle(name).dof,
+                "inputs": list(vehicle(name).input_labels)} for name, (description, _) in VEHICLES.items()]
+    if args.json:
+        print(json.dumps(listing, indent=2))
+    else:
+        print(_table([[v["name"], v["dof"], ", ".join(v["inputs"]), v["description"]] for v in listing],
+                     ["name", "dof", "inputs", "description"]))
+    return 0
+
+
+def _format_value(value) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in value) + "]" if isinstance(value, tuple) else f"{value:.6g}"
+
+
+def _cmd_report(args) -> int:
+    available = derivations()
+    names = args.names or list(available)
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise UnknownNameError(f"unknown derivation(s) {unknown}; known: {', '.join(available) or 'none installed'}")
+    out_root = Path(args.out)
+    for index, name in enumerate(names, 1):
+        build = available[name].load()
+        out_dir = out_root / name
+        out_dir.mkdir(parents=True, exist_ok=True)
+
+        def progress(message: str, _name=name, _index=index) -> None:
+            print(f"[{_index}/{len(names)}] {_name}: {message}", file=sys.stderr, flush=True)
+
+        build(out_dir, progress)
+        print(f"wrote {out_dir}")
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    models = sub.add_parser("models", help="list the vehicle library, or show one vehicle")
+    models.add_argument("action", nargs="?", choices=["list", "show"], default="list")
+    models.add_argument("name", nargs="?", help="vehicle name (with 'show')")
+    models.add_argument("--json", action="store_true", help="machine-readable output")
+    models.set_defaults(run=_cmd_models)
+    report = sub.add_parser("report", help="build derivation reports (all, or the ones named)")
+    report.add_argument("names", nargs="*", help="derivations to build (default: all)")
+    report.add_argument("--out", default="reports", help="output folder (default: ./reports)")
+    report.set_defaults(run=_cmd_report)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``uvsym`` console script; returns the exit status."""
+    args = _parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except UvsymError as exc:
+        print(f"uvsym: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,41 @@
+"""Typed exceptions of uvsym.
+
+Every error a user can cause is one of these, and its message names the problem
+(the parameter, the input, the option) rather than pointing into CasADi.
+"""
+
+__all__ = [
+    "UvsymError",
+    "ModelError",
+    "KinematicsError",
+    "ConfigurationError",
+    "IdentifiabilityError",
+    "UnknownNameError",
+]
+
+
+class UvsymError(Exception):
+    """Base class of every uvsym error."""
+
+
+class ModelError(UvsymError, ValueError):
+    """A vehicle model cannot be built from the parameters given (names the parameter)."""
+
+
+class KinematicsError(UvsymError, ValueError):
+    """A kinematic transformation is undefined at the requested state (e.g. theta = +-90 deg)."""
+
+
+class ConfigurationError(UvsymError, ValueError):
+    """An actuator configuration is malformed (sizes, angles, positions)."""
+
+
+class IdentifiabilityError(UvsymError, ValueError):
+    """Actuator values cannot be recovered from generalised forces for this configuration."""
+
+
+class UnknownNameError(UvsymError, KeyError):
+    """A vehicle, derivation or option name is not known; the message lists the known ones."""
+
+    def __str__(self) -> str:  # KeyError quotes its argument; keep the message readable
+        return str(self.args[0]) if self.args else ""

@@ -1,0 +1,63 @@
+"""Type-generic matrix helpers: the same code builds numpy arrays or CasADi expressions.
+
+Numeric inputs (floats, lists, numpy) give numpy float arrays; any CasADi ``SX``/``MX``/``DM``
+input gives a CasADi matrix. Model builders use these so one formula serves both.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "zeros_like_kind"]
+
+_CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
+
+
+def is_casadi(*values) -> bool:
+    """True when any value (or any element of a list/tuple value) is a CasADi matrix."""
+    for value in values:
+        if isinstance(value, _CASADI_TYPES):
+            return True
+        if isinstance(value, (list, tuple)) and is_casadi(*value):
+            return True
+    return False
+
+
+def stack(rows):
+    """Matrix from a list of rows of scalars: CasADi if any entry is CasADi, else numpy."""
+    if is_casadi(*[entry for row in rows for entry in row]):
+        return ca.vertcat(*[ca.horzcat(*row) for row in rows])
+    return np.array(rows, dtype=float)
+
+
+def block(rows):
+    """Matrix from a list of rows of matrix blocks (like ``np.block``), CasADi if any is."""
+    if is_casadi(*[b for row in rows for b in row]):
+        return ca.vertcat(*[ca.horzcat(*[ca.DM(b) if isinstance(b, np.ndarray) else b for b in row])
+                            for row in rows])
+    return np.block(rows)
+
+
+def matvec(A, x):
+    """A @ x for numpy or CasADi operands."""
+    if is_casadi(A, x):
+        return ca.mtimes(ca.DM(A) if isinstance(A, np.ndarray) else A, x)
+    return np.asarray(A, dtype=float) @ np.asarray(x, dtype=float).reshape(-1)
+
+
+def entries(vector, n: int, name: str = "vector"):
+    """The n entries of a vector as a list; ValueError naming ``name`` on a size mismatch."""
+    if isinstance(vector, _CASADI_TYPES):
+        if vector.numel() != n:
+            raise ValueError(f"{name} must have {n} entries, got shape {vector.shape}")
+        return [vector[i] for i in range(n)]
+    array = np.asarray(vector, dtype=float).reshape(-1)
+    if array.size != n:
+        raise ValueError(f"{name} must have {n} entries, got {array.size}")
+    return list(array)
+
+
+def zeros_like_kind(n: int, like):
+    """A zero column of n entries, CasADi SX if ``like`` is CasADi, else numpy."""
+    return ca.SX.zeros(n, 1) if is_casadi(like) else np.zeros(n)
