@@ -95,7 +95,7 @@ def _figure(responses: dict, path: Path) -> None:
 def _vehicle_section(name: str) -> str:
     model = vehicle(name)
     inputs = markdown_table(["input", "unit", "min", "max"],
-                            [[l, u, f"{lo:.6g}", f"{hi:.6g}"] for l, u, lo, hi in
+                            [[lab, u, f"{lo:.6g}", f"{hi:.6g}"] for lab, u, lo, hi in
                              zip(model.input_labels, model.input_units, model.u_min, model.u_max)])
     params = markdown_table(["parameter", "value", "unit", "meaning"],
                             [[n, _fmt(p.value), p.unit, p.description] for n, p in model.parameters.items()])

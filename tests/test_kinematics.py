@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvsym.errors import KinematicsError
-from uvsym.kinematics import J, Hmtrx, Rzyx, Smtrx, Tzyx, ssa
+from uvsym.kinematics import Hmtrx, J, Rzyx, Smtrx, Tzyx, ssa
 
 finite = st.floats(-10, 10, allow_nan=False)
 angle = st.floats(-math.pi, math.pi, allow_nan=False)

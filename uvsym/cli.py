@@ -40,8 +40,10 @@ def _cmd_models(args) -> int:
             print(json.dumps(summary, indent=2))
             return 0
         print(f"{model.name}: {model.description}")
-        print(f"{model.dof} DOF; states x = [eta; nu] = {', '.join(f'{l} ({u})' for l, u in zip(model.state_labels, model.state_units))}")
-        print("inputs: " + ", ".join(f"{i['label']} ({i['unit']}, {i['min']:.6g} .. {i['max']:.6g})" for i in summary["inputs"]))
+        states = ", ".join(f"{lab} ({unit})" for lab, unit in zip(model.state_labels, model.state_units))
+        print(f"{model.dof} DOF; states x = [eta; nu] = {states}")
+        print("inputs: " + ", ".join(f"{i['label']} ({i['unit']}, {i['min']:.6g} .. {i['max']:.6g})"
+                                     for i in summary["inputs"]))
         print("equations: M (nu_dot - nu_c_dot) + h(eta, nu) = tau(eta, nu, u);  h = " + " + ".join(model.term_names))
         print(f"nu_dot: {model.nu_dot.n_instructions()} SX instructions\n")
         print("M =\n" + np.array2string(model.M, precision=6, suppress_small=True, max_line_width=140) + "\n")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "zeros_like_kind"]
+__all__ = ["is_casadi", "stack", "block", "matvec", "entries"]
 
 _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
@@ -56,8 +56,3 @@ def entries(vector, n: int, name: str = "vector"):
     if array.size != n:
         raise ValueError(f"{name} must have {n} entries, got {array.size}")
     return list(array)
-
-
-def zeros_like_kind(n: int, like):
-    """A zero column of n entries, CasADi SX if ``like`` is CasADi, else numpy."""
-    return ca.SX.zeros(n, 1) if is_casadi(like) else np.zeros(n)

@@ -10,7 +10,9 @@ the first (thruster plus fins) comes from a vehicle model as ``B = d tau / d u``
   with both angles free contributes three columns.
 
 Actuator i is identifiable from tau exactly when no combination of the other columns can
-stand in for it: when every vector of the null space of B has a zero i-th entry.
+stand in for it: when every vector of the null space of B has a zero i-th entry. This rank test
+holds for any geometry; the paper's counting rules (at most 3 horizontal and 3 vertical fixed
+thrusters) are its special case for horizontal thrusters in the plane z = 0.
 """
 
 from __future__ import annotations

@@ -103,9 +103,9 @@ class Model:
             "name": self.name,
             "description": self.description,
             "dof": self.dof,
-            "states": [{"label": l, "unit": u} for l, u in zip(self.state_labels, self.state_units)],
-            "inputs": [{"label": l, "unit": u, "min": float(lo), "max": float(hi)}
-                       for l, u, lo, hi in zip(self.input_labels, self.input_units, self.u_min, self.u_max)],
+            "states": [{"label": lab, "unit": u} for lab, u in zip(self.state_labels, self.state_units)],
+            "inputs": [{"label": lab, "unit": u, "min": float(lo), "max": float(hi)}
+                       for lab, u, lo, hi in zip(self.input_labels, self.input_units, self.u_min, self.u_max)],
             "hull_terms": list(self.term_names),
             "M": self.M.tolist(),
             "parameters": self.parameters.to_dict(),

@@ -1,0 +1,133 @@
+"""Cost of one REMUS 100 nu_dot call: CasADi from Python, buffer(), generated C, plain numpy.
+
+Run ``python benchmarks/rhs.py``; writes ``benchmarks/results/rhs.json``. Times are medians of
+repeated batches within this one run; compare them as ratios (the machine is shared).
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from remus100_numpy import Remus100Numpy  # noqa: E402
+
+import uvsym  # noqa: E402
+
+RESULTS = Path(__file__).resolve().parent / "results" / "rhs.json"
+ETA = np.array([10.0, -5.0, 20.0, 0.1, -0.05, 0.7])
+NU = np.array([1.5, 0.1, -0.05, 0.02, -0.03, 0.04])
+U = np.array([0.1, -0.05, 1200.0])
+
+C_LOOP = r"""
+#include <stdio.h>
+#include <time.h>
+#include "nu_dot.h"
+int main(void) {
+  static casadi_real eta[6] = {10.0, -5.0, 20.0, 0.1, -0.05, 0.7};
+  static casadi_real nu[6] = {1.5, 0.1, -0.05, 0.02, -0.03, 0.04};
+  static casadi_real u[3] = {0.1, -0.05, 1200.0};
+  static casadi_real V_c = 0.0, beta_c = 0.0, out[6], w[nu_dot_SZ_W];
+  static casadi_int iw[nu_dot_SZ_IW];
+  const casadi_real *arg[nu_dot_SZ_ARG] = {eta, nu, u, &V_c, &beta_c};
+  casadi_real *res[nu_dot_SZ_RES] = {out};
+  const long n = 2000000;
+  double best = 1e30, sink = 0.0;
+  for (int rep = 0; rep < 5; ++rep) {
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (long i = 0; i < n; ++i) {
+      nu[0] = 1.5 + 1e-9 * (double)(i & 1023);   /* defeat hoisting */
+      nu_dot(arg, res, iw, w, 0);
+      sink += out[0];
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double ns = ((t1.tv_sec - t0.tv_sec) * 1e9 + (t1.tv_nsec - t0.tv_nsec)) / (double)n;
+    if (ns < best) best = ns;
+  }
+  printf("%.3f %.17g\n", best, sink);
+  return 0;
+}
+"""
+
+
+def median_time(call, repeat: int = 7, number: int = 2000) -> float:
+    """Median seconds per call over ``repeat`` batches of ``number`` calls."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        for _ in range(number):
+            call()
+        times.append((time.perf_counter() - start) / number)
+    return float(np.median(times))
+
+
+def c_loop_ns(function: ca.Function) -> float | None:
+    """ns per call of the generated C of ``function`` timed in a C loop (None without gcc)."""
+    compiler = shutil.which("gcc") or shutil.which("cc")
+    if compiler is None:
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        generator = ca.CodeGenerator("nu_dot", {"with_header": True})
+        generator.add(function)
+        generator.generate(str(tmp) + "/")
+        (tmp / "main.c").write_text(C_LOOP)
+        subprocess.run([compiler, "-O3", "-o", str(tmp / "bench"), str(tmp / "main.c"), str(tmp / "nu_dot.c"), "-lm"],
+                       check=True, cwd=tmp)
+        out = subprocess.run([str(tmp / "bench")], capture_output=True, text=True, check=True).stdout
+    return float(out.split()[0])
+
+
+def main() -> dict:
+    model = uvsym.vehicle("remus100")
+    f = model.nu_dot
+    baseline = Remus100Numpy(model)
+    expected = np.array(f(ETA, NU, U, 0, 0)).ravel()
+    np.testing.assert_allclose(baseline.nu_dot(ETA, NU, U), expected, rtol=1e-9, atol=1e-12)
+
+    args_dm = [ca.DM(ETA), ca.DM(NU), ca.DM(U), ca.DM(0), ca.DM(0)]
+    numpy_s = median_time(lambda: baseline.nu_dot(ETA, NU, U), number=500)
+    python_numpy_args_s = median_time(lambda: f(ETA, NU, U, 0.0, 0.0))
+    python_dm_args_s = median_time(lambda: f(*args_dm))
+
+    buffer, trigger = f.buffer()
+    inputs = [np.array(a, dtype=float) for a in (ETA, NU, U, [0.0], [0.0])]
+    output = np.zeros(6)
+    for i, a in enumerate(inputs):
+        buffer.set_arg(i, memoryview(a))
+    buffer.set_res(0, memoryview(output))
+    buffer_s = median_time(trigger, number=20000)
+    np.testing.assert_allclose(output, expected, rtol=1e-14)
+
+    c_ns = c_loop_ns(f)
+    results = {
+        "vehicle": "remus100",
+        "function": "nu_dot(eta, nu, u, V_c, beta_c)",
+        "sx_instructions": f.n_instructions(),
+        "numpy_us_per_call": numpy_s * 1e6,
+        "casadi_python_numpy_args_us_per_call": python_numpy_args_s * 1e6,
+        "casadi_python_dm_args_us_per_call": python_dm_args_s * 1e6,
+        "casadi_buffer_us_per_call": buffer_s * 1e6,
+        "c_ns_per_call": c_ns,
+        "speedup_vs_numpy": None if c_ns is None else numpy_s * 1e9 / c_ns,
+        "targets": {"c_ns_per_call_max": 500, "speedup_vs_numpy_min": 150},
+        "machine": {"python": platform.python_version(), "casadi": ca.__version__, "numpy": np.__version__,
+                    "processor": platform.machine()},
+    }
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
+    return results
+
+
+if __name__ == "__main__":
+    print(json.dumps(main(), indent=2))

@@ -1,0 +1,69 @@
+"""The uvsym command line: version, vehicle listing and inspection, reports."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import uvsym
+from uvsym.cli import main
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "uvsym.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_version():
+    result = run("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"uvsym {uvsym.__version__}"
+
+
+def test_models_json_lists_the_library(capsys):
+    assert main(["models", "--json"]) == 0
+    listing = json.loads(capsys.readouterr().out)
+    assert [v["name"] for v in listing] == uvsym.vehicle_names()
+    assert {v["name"]: v["dof"] for v in listing}["otter3dof"] == 3
+
+
+def test_models_show_prints_parameters_with_units(capsys):
+    assert main(["models", "show", "remus100"]) == 0
+    out = capsys.readouterr().out
+    assert "delta_r (rad" in out and "n (rpm" in out
+    assert "rho" in out and "kg/m^3" in out and "h = coriolis + damping" in out
+
+
+def test_models_show_json(capsys):
+    assert main(["models", "show", "otter", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["parameters"]["mp"] == {"value": 25.0, "unit": "kg", "description": "payload mass"}
+    assert len(summary["M"]) == 6
+
+
+@pytest.mark.parametrize("args", [["models", "show", "nautilus"], ["models", "show"], ["report", "nonesuch"]])
+def test_unknown_names_exit_2_with_a_message(args):
+    result = run(*args)
+    assert result.returncode == 2
+    assert "uvsym: error:" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_report_models_is_deterministic(tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    assert main(["report", "models", "--out", str(first)]) == 0
+    assert main(["report", "models", "--out", str(second)]) == 0
+    names = sorted(p.name for p in (first / "models").iterdir())
+    assert names == ["report.md", "results.json", "step_responses.svg"]
+    for name in names:
+        assert (first / "models" / name).read_bytes() == (second / "models" / name).read_bytes(), name
+    results = json.loads((first / "models" / "results.json").read_text())
+    assert results["reference_cases_passed"] == results["reference_cases"] == 13
+    assert results["docking_auv_B_matches_eq27"] is True
+
+
+def test_committed_models_report_is_current(tmp_path):
+    """The committed reports/models text files are what the current code builds."""
+    committed = Path(__file__).resolve().parents[1] / "reports" / "models"
+    assert main(["report", "models", "--out", str(tmp_path)]) == 0
+    for name in ("report.md", "results.json"):
+        assert (tmp_path / "models" / name).read_text() == (committed / name).read_text(), f"stale {name}"
