@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from uvsym.models.hydrodynamics import hoerner_cd
-from uvsym.models.vehicles.remus100_hull import hull
+from uvsym.models.vehicles.remus100_hull import MUNK_FREE_ENTRIES, hull
 
 
 def _skew(a):
@@ -59,7 +59,7 @@ class Remus100Numpy:
             X_prop = rho * D**4 * p("KT_0") * abs(n_rps) * n_rps
             K_prop = rho * D**5 * p("KQ_0") * abs(n_rps) * n_rps
         CA = _m2c(self.MA, nu)
-        for i, j in ((4, 0), (0, 4), (4, 2), (2, 4), (5, 0), (0, 5), (5, 1), (1, 5)):
+        for i, j in MUNK_FREE_ENTRIES:
             CA[i, j] = 0
         C = _m2c(self.MRB, nu) + CA
         decay = math.exp(-p("damping_decay") * U)
