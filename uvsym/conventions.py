@@ -6,7 +6,7 @@ Fossen's notation: ``eta`` NED position and zyx Euler angles, ``nu`` body-fixed 
 
 from __future__ import annotations
 
-__all__ = ["POSITION_LABELS", "VELOCITY_LABELS", "POSITION_UNITS", "VELOCITY_UNITS", "FORCE_UNITS",
+__all__ = ["POSITION_LABELS", "VELOCITY_LABELS", "POSITION_UNITS", "VELOCITY_UNITS", "FORCE_LABELS", "FORCE_UNITS",
            "SYMBOLS"]
 
 POSITION_LABELS = {
@@ -19,6 +19,7 @@ VELOCITY_LABELS = {
 }
 POSITION_UNITS = {6: ("m", "m", "m", "rad", "rad", "rad"), 3: ("m", "m", "rad")}
 VELOCITY_UNITS = {6: ("m/s", "m/s", "m/s", "rad/s", "rad/s", "rad/s"), 3: ("m/s", "m/s", "rad/s")}
+FORCE_LABELS = {6: ("X", "Y", "Z", "K", "M", "N"), 3: ("X", "Y", "N")}
 FORCE_UNITS = {6: ("N", "N", "N", "N m", "N m", "N m"), 3: ("N", "N", "N m")}
 
 # Symbol -> (meaning, frame, unit); the README's conventions table is this table.

@@ -11,6 +11,11 @@ __all__ = [
     "ConfigurationError",
     "IdentifiabilityError",
     "UnknownNameError",
+    "FaultError",
+    "ScenarioError",
+    "SimulationError",
+    "ObserverError",
+    "CodegenError",
 ]
 
 
@@ -32,6 +37,26 @@ class ConfigurationError(UvsymError, ValueError):
 
 class IdentifiabilityError(UvsymError, ValueError):
     """Actuator values cannot be recovered from generalised forces for this configuration."""
+
+
+class FaultError(UvsymError, ValueError):
+    """A fault or its time profile is malformed (kind, value, onset, target index)."""
+
+
+class ScenarioError(UvsymError, ValueError):
+    """A scenario is invalid; the message names the field (e.g. ``faults[1].kind``)."""
+
+
+class SimulationError(UvsymError, RuntimeError):
+    """A simulation cannot run or failed (bad method or grid, non-finite state, integrator failure)."""
+
+
+class ObserverError(UvsymError, ValueError):
+    """An observer cannot be built or run as asked (unobservable channel, bad gain, wrong sizes)."""
+
+
+class CodegenError(UvsymError, RuntimeError):
+    """C code could not be generated, compiled or loaded (names the compiler command and its output)."""
 
 
 class UnknownNameError(UvsymError, KeyError):

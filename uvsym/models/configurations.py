@@ -139,8 +139,9 @@ def identifiability(config: ActuatorConfiguration) -> Identifiability:
     3 horizontal and 3 vertical fixed thrusters; at most 6 controllable inputs in all).
     """
     B = np.asarray(config.B, dtype=float)
-    if B.ndim != 2 or B.shape[0] != 6 or not np.all(np.isfinite(B)):
-        raise ConfigurationError(f"{config.name}: B must be a finite 6 x m matrix, got shape {B.shape}")
+    if B.ndim != 2 or not 1 <= B.shape[0] <= 6 or not np.all(np.isfinite(B)):
+        raise ConfigurationError(f"{config.name}: B must be a finite k x m matrix with 1 <= k <= 6 "
+                                 f"force rows, got shape {B.shape}")
     m = B.shape[1]
     s = np.linalg.svd(B, compute_uv=False)
     rank = int(np.sum(s > RANK_TOL * max(s[0], 1e-300)))

@@ -98,17 +98,15 @@ def crossflow_drag(L: float, B: float, T: float, nu_r, rho: float, strips: int =
 
     L length (m), B beam (m), T draft (m), nu_r (6,) relative velocity, rho (kg/m^3).
     """
-    cd = hoerner_cd(B, T)
-    dx = L / strips
+    scale = 0.5 * rho * T * hoerner_cd(B, T) * L / strips
     v_r, r = nu_r[1], nu_r[5]
     Y = 0.0
     N = 0.0
-    x = -L / 2.0
-    for _ in range(strips + 1):
+    for k in range(strips + 1):
+        x = -L / 2.0 + k * L / strips
         u_cf = ca.fabs(v_r + x * r) * (v_r + x * r)
-        Y = Y - 0.5 * rho * T * cd * u_cf * dx
-        N = N - 0.5 * rho * T * cd * x * u_cf * dx
-        x += dx
+        Y = Y - scale * u_cf
+        N = N - (scale * x) * u_cf
     return ca.vertcat(0.0, Y, 0.0, 0.0, 0.0, N)
 
 
@@ -125,12 +123,15 @@ def lift_drag(span: float, area: float, CD_0: float, nu_r, rho: float):
     aspect = span**2 / area
     cl_alpha = math.pi * aspect / (1.0 + math.sqrt(1.0 + (aspect / 2.0) ** 2))
     u_r, v_r, w_r = nu_r[0], nu_r[1], nu_r[2]
-    alpha = ca.atan2(w_r, u_r + SPEED_EPS)
+    u_eps = u_r + SPEED_EPS
+    alpha = ca.atan2(w_r, u_eps)
     CL = cl_alpha * alpha
     CD = CD_0 + CL**2 / (math.pi * oswald * aspect)
     q_area = 0.5 * rho * (u_r**2 + v_r**2 + w_r**2) * area
     F_drag, F_lift = q_area * CD, q_area * CL
-    ca_, sa_ = ca.cos(alpha), ca.sin(alpha)
+    # cos and sin of alpha without evaluating them: (u, w) / |(u, w)|
+    norm = ca.sqrt(u_eps**2 + w_r**2)
+    ca_, sa_ = u_eps / norm, w_r / norm
     return ca.vertcat(ca_ * (-F_drag) - sa_ * (-F_lift), 0.0,
                       sa_ * (-F_drag) + ca_ * (-F_lift), 0.0, 0.0, 0.0)
 
