@@ -1,0 +1,139 @@
+"""Actuator-fault observers of the core paper (seeds/000, Theorems 1-3, eqs. 2-17).
+
+For a vehicle ``M nu' + h(eta, nu) = tau`` with desired action ``tau_d`` the three fault types
+(Definition 1) deliver
+
+    proportional  tau = T_d f      (T_d = diag(tau_d), f = 1 when healthy)
+    bias          tau = tau_d + f
+    constant      tau = f
+
+Each observer keeps a state ``x`` and estimates ``f_hat = x - R(nu)``. ``R`` is written once per
+type; ``L = dR/dnu`` is taken by ``casadi.jacobian``. With
+
+    x' = L M^-1 (G x - G R - h + b),      (G, b) = (T_d, 0), (I, tau_d), (I, 0)
+
+the unknown ``nu'`` cancels and the error ``e = f - f_hat`` obeys ``e' = L M^-1 G e`` while
+``tau_d`` is constant (eqs. 5-11).
+
+``R`` per form: ``paper`` -- ``R_p = -K M^-1 T_d nu`` and ``R_a = R_c = -K M^-1 nu`` exactly as
+printed, so ``A = -K (M^-1 T_d)^2`` or ``-K M^-2``; ``momentum`` -- ``R_p = -K T_d M nu`` and
+``R_a = R_c = -K M nu``, so ``A = -K T_d^2`` or ``-K`` for *any* symmetric positive definite M.
+With M diagonal the two forms are the same observer with ``K_momentum = K_paper / m_i^2``; with
+a coupled M (a CG offset) the paper's proportional observer need not converge and its bias
+observer converges with coupled, badly spread rates, while the momentum form keeps one
+decoupled rate per channel (``k_i tau_d,i^2`` or ``k_i``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from uvsym.errors import ObserverError
+from uvsym.models.model import Model
+
+__all__ = ["KINDS", "FORMS", "ActuatorObserver", "actuator_observer", "proportional_observer", "bias_observer",
+           "constant_observer", "init_state"]
+
+KINDS = ("proportional", "bias", "constant")
+FORMS = ("paper", "momentum")
+
+
+@dataclass(frozen=True)
+class ActuatorObserver:
+    """One observer and the symbolic pieces it was derived from.
+
+    function(x, eta, nu, tau_d, K) -> (x_dot, f_hat); R(nu, tau_d, K) -> R; L(nu, tau_d, K) -> dR/dnu;
+    error_matrix(tau_d, K) -> A with ``e' = A e`` for constant ``tau_d``;
+    error_dynamics(e, nu, nu_dot, tau_d, tau_d_dot, K) -> e' exactly, including the term
+    ``-(dR/dtau_d) tau_d'`` that the paper's proof drops when ``tau_d`` varies.
+    """
+
+    kind: str
+    form: str
+    model_name: str
+    function: ca.Function
+    R: ca.Function
+    L: ca.Function
+    error_matrix: ca.Function
+    error_dynamics: ca.Function
+
+
+def actuator_observer(model: Model, kind: str, form: str = "paper") -> ActuatorObserver:
+    """Build the observer of ``kind`` (proportional, bias, constant) for ``model``.
+
+    Raises
+    ------
+    ObserverError
+        For an unknown kind or form, or the paper's proportional observer on a model whose M is
+        not diagonal (Assumption 1; its error dynamics need not converge there: use
+        ``form="momentum"``).
+    """
+    if kind not in KINDS:
+        raise ObserverError(f"unknown observer kind {kind!r}; known: {', '.join(KINDS)}")
+    if form not in FORMS:
+        raise ObserverError(f"unknown observer form {form!r}; known: {', '.join(FORMS)}")
+    M = model.M
+    if kind == "proportional" and form == "paper" and not np.allclose(M, np.diag(np.diag(M)), rtol=0, atol=1e-12):
+        raise ObserverError(f"{model.name}: the paper's proportional observer needs a diagonal mass matrix "
+                            "(Assumption 1: CG = CB, symmetric vehicle); use form='momentum'")
+    n = model.dof
+    M_inv = ca.DM(np.linalg.inv(M))
+    P = M_inv if form == "paper" else ca.DM(M)
+    x, eta, nu = ca.SX.sym("x", n), ca.SX.sym("eta", n), ca.SX.sym("nu", n)
+    tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
+    T_d, K_mat = ca.diag(tau_d), ca.diag(K)
+
+    if kind == "proportional":
+        gain = ca.mtimes(M_inv, T_d) if form == "paper" else ca.mtimes(T_d, P)
+        R = -ca.mtimes(K_mat, ca.mtimes(gain, nu))
+        G, b = T_d, ca.SX.zeros(n)
+    else:
+        R = -ca.mtimes(K_mat, ca.mtimes(P, nu))
+        G, b = ca.SX.eye(n), (tau_d if kind == "bias" else ca.SX.zeros(n))
+    L = ca.jacobian(R, nu)
+    h = model.h(eta, nu)
+    LM = ca.mtimes(L, M_inv)
+    x_dot = ca.mtimes(LM, ca.mtimes(G, x) - ca.mtimes(G, R) - h + b)
+    f_hat = x - R
+
+    names = ["x", "eta", "nu", "tau_d", "K"]
+    function = ca.Function(f"{kind}_observer", [x, eta, nu, tau_d, K], [x_dot, f_hat], names, ["x_dot", "f_hat"])
+    # Exact error dynamics: with f constant, x = f - e + R(nu, tau_d) and the faulty plant
+    # M nu' = G f + b - h, e' = -x' + L nu' + (dR/dtau_d) tau_d'. A = L M^-1 G when tau_d' = 0.
+    e, f, tau_d_dot = ca.SX.sym("e", n), ca.SX.sym("f", n), ca.SX.sym("tau_d_dot", n)
+    plant_nu_dot = ca.mtimes(M_inv, ca.mtimes(G, f) + b - h)
+    e_dot = (-ca.substitute(x_dot, x, f - e + R) + ca.mtimes(L, plant_nu_dot)
+             + ca.mtimes(ca.jacobian(R, tau_d), tau_d_dot))
+    A = ca.mtimes(LM, G)
+    return ActuatorObserver(
+        kind=kind, form=form, model_name=model.name, function=function,
+        R=ca.Function("R", [nu, tau_d, K], [R], ["nu", "tau_d", "K"], ["R"]),
+        L=ca.Function("L", [nu, tau_d, K], [L], ["nu", "tau_d", "K"], ["L"]),
+        error_matrix=ca.Function("A", [tau_d, K], [A], ["tau_d", "K"], ["A"]),
+        error_dynamics=ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K], [e_dot],
+                                   ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"], ["e_dot"]),
+    )
+
+
+def proportional_observer(model: Model, form: str = "paper") -> ca.Function:
+    """Theorem 1 (eqs. 2, 12-13): ``x(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the proportional factors."""
+    return actuator_observer(model, "proportional", form).function
+
+
+def bias_observer(model: Model, form: str = "paper") -> ca.Function:
+    """Theorem 2 (eqs. 3, 14-15): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the biases (N, N m)."""
+    return actuator_observer(model, "bias", form).function
+
+
+def constant_observer(model: Model, form: str = "paper") -> ca.Function:
+    """Theorem 3 (eqs. 4, 16-17): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the delivered forces."""
+    return actuator_observer(model, "constant", form).function
+
+
+def init_state(observer: ca.Function, eta, nu, tau_d, K) -> np.ndarray:
+    """The observer state x with f_hat = 0 at (eta, nu, tau_d): since f_hat = x - R, x = R = -f_hat(x=0)."""
+    n = observer.size1_in("x")
+    return -np.asarray(observer(np.zeros(n), eta, nu, tau_d, K)[1]).ravel()

@@ -1,0 +1,86 @@
+"""Fault-tolerant correction of the commands, not the controller (seeds/000, sec. 3).
+
+For identified faults the corrected command is ``u*_i = u_d,i / f_p,i`` (proportional),
+``u*_i = u_d,i - f_a,i`` (bias), and an actuator with a constant (stuck) fault is stopped and
+its share of ``tau_d`` handed to the others. Commands are then kept within
+``[u_min, u_max]``: what one actuator cannot deliver goes to the redundant ones by bounded
+least squares (``scipy.optimize.lsq_linear``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import lsq_linear
+
+from uvsym.errors import IdentifiabilityError
+from uvsym.observers.identification import ActuatorFaultEstimate
+
+__all__ = ["Correction", "linear_correction", "corrected_commands"]
+
+
+@dataclass(frozen=True)
+class Correction:
+    """Command correction ``u_cmd = sat(S u_d + o)``: S (m, m), o (m,) in the inputs' units."""
+
+    S: np.ndarray
+    o: np.ndarray
+
+
+def linear_correction(faults: dict[str, ActuatorFaultEstimate], labels: tuple[str, ...], B: np.ndarray) -> Correction:
+    """The correction as a linear map ``u* = S u_d + o`` (before bounds).
+
+    A stopped actuator's column of tau is redistributed by the pseudo-inverse of the others' B.
+    """
+    m = len(labels)
+    S, o = np.eye(m), np.zeros(m)
+    B = np.asarray(B, dtype=float)
+    stopped = []
+    for label, fault in faults.items():
+        i = labels.index(label)
+        if fault.kind == "proportional":
+            if abs(fault.value) <= 1e-9:
+                raise IdentifiabilityError(f"{label}: a proportional factor of {fault.value} cannot be corrected")
+            S[i, i] = 1.0 / fault.value
+        elif fault.kind == "bias":
+            o[i] = -fault.value
+        elif fault.kind == "constant":
+            stopped.append(i)
+    for i in stopped:
+        others = [j for j in range(m) if j not in stopped]
+        if not others:
+            raise IdentifiabilityError("every actuator is stopped: nothing can take over")
+        S[i, :] = 0.0
+        S[others, i] += np.linalg.pinv(B[:, others]) @ B[:, i]
+    return Correction(S, o)
+
+
+def corrected_commands(u_d, faults: dict[str, ActuatorFaultEstimate], labels: tuple[str, ...], B: np.ndarray,
+                       u_min, u_max) -> np.ndarray:
+    """Corrected commands u* (m,) within bounds: the linear correction, then bounded least squares.
+
+    The actuators minimise ``|B_eff (u* - u_lin)|`` subject to bounds, where B_eff weights each
+    actuator by its effectiveness (``f_p`` for proportional faults, 0 for stopped ones) -- so
+    the excess of a saturated actuator goes to the ones that can still act on the same forces.
+    """
+    u_d = np.asarray(u_d, dtype=float)
+    linear = linear_correction(faults, labels, B)
+    u_lin = linear.S @ u_d + linear.o
+    effectiveness = np.ones(len(labels))
+    lower, upper = np.asarray(u_min, dtype=float).copy(), np.asarray(u_max, dtype=float).copy()
+    for label, fault in faults.items():
+        i = labels.index(label)
+        if fault.kind == "proportional":
+            effectiveness[i] = fault.value
+        elif fault.kind == "constant":
+            effectiveness[i], lower[i], upper[i] = 0.0, -1e-12, 1e-12
+        elif fault.kind == "bias":
+            lower[i], upper[i] = lower[i] - fault.value, upper[i] - fault.value
+            lower[i], upper[i] = max(lower[i], u_min[i]), min(upper[i], u_max[i])
+    if np.all((u_lin >= lower) & (u_lin <= upper)):
+        return u_lin
+    B_eff = np.asarray(B, dtype=float) * effectiveness
+    wanted = B_eff @ u_lin
+    solution = lsq_linear(B_eff, wanted, bounds=(lower, upper), method="bvls")
+    return solution.x
