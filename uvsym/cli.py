@@ -84,6 +84,34 @@ def _cmd_report(args) -> int:
     return 0
 
 
+def _cmd_simulate(args) -> int:
+    from uvsym.progress import ProgressBar
+    from uvsym.sim.scenario import load_scenario, shipped_scenarios
+    from uvsym.sim.simulation import simulate_scenario
+
+    if args.list or not args.scenario:
+        rows = [[name, str(path.name)] for name, path in shipped_scenarios().items()]
+        print(_table(rows, ["shipped scenario", "file"]))
+        return 0
+    scenario = load_scenario(args.scenario)
+    bar = ProgressBar(f"{scenario.name} ({args.method})")
+    result = simulate_scenario(scenario, method=args.method, progress=bar)
+    bar.close()
+    wall = result.meta["wall_s"]
+    print(f"{scenario.name}: {scenario.model.name}, {scenario.duration:g} s at {scenario.step:g} s, method "
+          f"{args.method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
+          f"build {result.meta['build_s']:.2f} s")
+    x = result["x"]
+    print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
+    if args.out:
+        print(f"wrote {result.save(args.out)}")
+    if args.plot is not None:
+        figure = Path(args.plot or (Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name}.svg"))
+        result.plot(figure)
+        print(f"wrote {figure}")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
@@ -97,6 +125,17 @@ def _parser() -> argparse.ArgumentParser:
     report.add_argument("names", nargs="*", help="derivations to build (default: all)")
     report.add_argument("--out", default="reports", help="output folder (default: ./reports)")
     report.set_defaults(run=_cmd_report)
+    from uvsym.sim.run import METHODS
+
+    simulate = sub.add_parser("simulate", help="run a scenario (a TOML file or a shipped example's name)")
+    simulate.add_argument("scenario", nargs="?", help="scenario file or shipped name (none: list the shipped ones)")
+    simulate.add_argument("--method", choices=METHODS, default="fast",
+                          help="fast (compiled fixed-step RK4, default) or a CasADi integrator")
+    simulate.add_argument("--out", help="write the result (.npz, .csv or .mat)")
+    simulate.add_argument("--plot", nargs="?", const="", default=None,
+                          help="write a quick-look figure (.svg or .png; default: next to --out)")
+    simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
+    simulate.set_defaults(run=_cmd_simulate)
     return parser
 
 

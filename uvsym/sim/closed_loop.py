@@ -1,0 +1,171 @@
+"""The closed loop as CasADi Functions: a discrete part at the sample rate and a continuous plant.
+
+State ``z = [x (2 dof); a (m); xc; xo; a_expected (m); held (2 dof)]``: plant state, actuator
+state, controller state, observer states, the response a healthy actuator would give to the
+commands (the actuator model run in the controller), and the sensor latch of stuck faults. Per-sample input
+``w = [t; noise (2 dof); V_c; beta_c; vec(S) (m m); o (m)]``: time, standard normal draws, the
+current, and the command correction ``u_cmd = sat(S u_d + o)`` set by a supervisor.
+
+At each sample the discrete part measures ``y`` (sensor faults), runs the controller and the
+observers, and holds ``u_cmd`` over the sample; the plant ``[x; a]`` is then integrated over
+the sample with actuator faults acting on ``a`` in continuous time. The observers' desired
+action is ``tau_d = tau(y, a_expected)``: what healthy actuators deliver for the commands sent,
+so that an actuator's own lag is not mistaken for a fault.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from uvsym.conventions import FORCE_LABELS
+from uvsym.errors import SimulationError
+from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
+from uvsym.models.actuators import saturate
+from uvsym.models.model import Model
+from uvsym.observers.discrete import discrete_observer, discrete_state_size
+from uvsym.sim.controllers import Autopilot
+
+__all__ = ["ObserverBlock", "ClosedLoop", "build_closed_loop", "rk4"]
+
+
+@dataclass(frozen=True)
+class ObserverBlock:
+    """An observer run in the loop: ``function(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``.
+
+    It runs in its sampled-data form (:mod:`uvsym.observers.discrete`) from ``f_hat = 0``.
+    ``K`` the gain entries; ``labels`` name the entries of ``f_hat`` and ``units`` their units.
+    """
+
+    name: str
+    function: ca.Function
+    K: np.ndarray
+    labels: tuple[str, ...]
+    units: tuple[str, ...]
+
+    @property
+    def n_state(self) -> int:
+        """Entries of its sampled-data state."""
+        return discrete_state_size(self.function.size1_in("x"))
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """Sizes, labels and Functions of one closed loop (see the module docstring for z and w).
+
+    discrete(z, w) -> (z_disc, u_cmd, out): z_disc the next [xc; xo; a_expected; held], out the
+    logged signals; plant_ode(s, u_cmd, env, t) -> s_dot for s = [x; a]; step(z, w) -> (z_next, out)
+    the fixed-step path (discrete part, then ``substeps`` RK4 steps of the plant). ``layout`` maps
+    the parts of z (x, a, xc, xo, a_expected, held) to their slices.
+    """
+
+    model: Model
+    dt: float
+    substeps: int
+    n_z: int
+    n_w: int
+    n_s: int
+    discrete: ca.Function
+    plant_ode: ca.Function
+    step: ca.Function
+    layout: dict
+    observer_slices: dict
+    signals: dict  # name -> (slice of out, labels, units)
+
+
+def rk4(ode, s, h: float, steps: int, *args, t=0.0):
+    """``steps`` classical RK4 steps of ``s' = ode(s, *args, t)`` over ``h`` seconds (symbolic)."""
+    dh = h / steps
+    for i in range(steps):
+        ti = t + i * dh
+        k1 = ode(s, *args, ti)
+        k2 = ode(s + dh / 2 * k1, *args, ti + dh / 2)
+        k3 = ode(s + dh / 2 * k2, *args, ti + dh / 2)
+        k4 = ode(s + dh * k3, *args, ti + dh)
+        s = s + dh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return s
+
+
+def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
+                      actuator_faults: tuple[ActuatorFault, ...] = (),
+                      sensor_faults: tuple[SensorFault, ...] = (),
+                      observers: tuple[ObserverBlock, ...] = (),
+                      substeps: int = 1, current: tuple[float, float] | None = None) -> ClosedLoop:
+    """The closed loop of ``model`` under ``controller`` sampled every ``dt`` seconds.
+
+    current: a constant (V_c m/s, beta_c rad) built into the fixed-step path (fewer operations),
+    or None to read the current from each sample's input ``w``.
+    """
+    if not dt > 0.0:
+        raise SimulationError(f"sample period dt must be positive (s), got {dt}")
+    if substeps < 1:
+        raise SimulationError(f"substeps must be >= 1, got {substeps}")
+    controller.check(model.input_labels, model.dof)
+    n, m = 2 * model.dof, model.n_inputs
+    n_c = len(controller.state_labels)
+    n_o = sum(obs.n_state for obs in observers)
+    layout, start = {}, 0
+    for part, size in (("x", n), ("a", m), ("xc", n_c), ("xo", n_o), ("a_expected", m), ("held", n)):
+        layout[part], start = slice(start, start + size), start + size
+    n_z, n_w, n_s = start, 1 + n + 2 + m * m + m, n + m
+
+    z, w = ca.SX.sym("z", n_z), ca.SX.sym("w", n_w)
+    x, xc, xo, a_expected, held = (z[layout[p]] for p in ("x", "xc", "xo", "a_expected", "held"))
+    t, noise, V_c, beta_c = w[0], w[1:1 + n], w[1 + n], w[2 + n]
+    S = ca.reshape(w[3 + n:3 + n + m * m], m, m)
+    o = w[3 + n + m * m:]
+
+    y, held_next = apply_sensor_faults(x, t, sensor_faults, held, noise)
+    xc_next, u_d, refs = controller.law(xc, y, dt, model)
+    u_cmd = saturate(ca.mtimes(S, u_d) + o, ca.DM(model.u_min), ca.DM(model.u_max))
+    eta_y, nu_y = y[:model.dof], y[model.dof:]
+    tau_d = model.tau(eta_y, nu_y, a_expected, 0.0, 0.0)
+    a_expected_next = rk4(lambda a, _t: model.actuator_rate(a, u_cmd), a_expected, dt, substeps)
+
+    xo_next, estimates, observer_slices, start = [], [], {}, 0
+    for obs in observers:
+        s_next, f_hat = discrete_observer(obs.function, dt)(xo[start:start + obs.n_state], eta_y, nu_y, tau_d,
+                                                            ca.DM(obs.K))
+        xo_next.append(s_next)
+        estimates.append(f_hat)
+        observer_slices[obs.name] = slice(start, start + obs.n_state)
+        start += obs.n_state
+
+    a_now = z[layout["a"]]
+    out_parts = {
+        "x": (x, model.state_labels, model.state_units),
+        "y": (y, model.state_labels, model.state_units),
+        "u_desired": (u_d, model.input_labels, model.input_units),
+        "u_command": (u_cmd, model.input_labels, model.input_units),
+        "u_expected": (a_expected, model.input_labels, model.input_units),
+        "u_actual": (apply_actuator_faults(a_now, t, actuator_faults), model.input_labels, model.input_units),
+        "tau_desired": (tau_d, FORCE_LABELS[model.dof], model.force_units),
+        "reference": (refs, controller.reference_labels, controller.reference_units),
+    }
+    for obs, f_hat in zip(observers, estimates):
+        out_parts[f"f_hat/{obs.name}"] = (f_hat, obs.labels, obs.units)
+    out = ca.vertcat(*[part[0] for part in out_parts.values()])
+    signals, offset = {}, 0
+    for name, (expr, labels, units) in out_parts.items():
+        signals[name] = (slice(offset, offset + expr.numel()), tuple(labels), tuple(units))
+        offset += expr.numel()
+
+    z_disc = ca.vertcat(xc_next, *xo_next, a_expected_next, held_next)
+    # dense outputs: buffers and mapaccum read them as plain arrays
+    z_disc, u_cmd, out = ca.densify(z_disc), ca.densify(u_cmd), ca.densify(out)
+    discrete = ca.Function("discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
+
+    s, uc, env, ts = ca.SX.sym("s", n_s), ca.SX.sym("u_cmd", m), ca.SX.sym("env", 2), ca.SX.sym("t")
+    applied = apply_actuator_faults(s[n:], ts, actuator_faults)
+    s_dot = ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(s[n:], uc))
+    plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
+
+    env_step = ca.vertcat(V_c, beta_c) if current is None else ca.DM(current)
+    s_next = rk4(plant_ode, z[:n_s], dt, substeps, u_cmd, env_step, t=t)
+    step = ca.Function("step", [z, w], [ca.densify(ca.vertcat(s_next, z_disc)), out], ["z", "w"], ["z_next", "out"],
+                       {"cse": True})
+    return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
+                      plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
+                      signals=signals)

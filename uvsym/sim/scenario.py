@@ -1,0 +1,270 @@
+"""Scenarios as data: a TOML file names the vehicle, initial state, controller, faults, observers,
+current, duration and step. Every field is checked; an error names it (``faults[2].kind``).
+
+Units are SI (m, s, rad, N) as everywhere in uvsym; only keys ending in ``_deg`` take degrees.
+The shipped examples (``uvsym simulate --list``) document every field.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from uvsym.errors import FaultError, ModelError, ScenarioError, UnknownNameError
+from uvsym.faults import ActuatorFault, Profile, SensorFault
+from uvsym.models.model import Model
+from uvsym.models.registry import vehicle
+from uvsym.observers import FORMS, KINDS
+from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
+
+__all__ = ["Scenario", "ObserverSpec", "load_scenario", "parse_scenario", "shipped_scenarios"]
+
+_PROFILE_KEYS = ("profile", "onset", "end", "duration", "rate", "period", "duty")
+
+
+@dataclass(frozen=True)
+class ObserverSpec:
+    """An actuator-fault observer to run: kind, form, convergence time constant (s), nominal tau_d."""
+
+    kind: str
+    form: str
+    time_constant: float
+    tau_d: tuple[float, ...] | None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (see the module docstring); ``model`` is built with the overrides."""
+
+    name: str
+    description: str
+    model: Model
+    duration: float
+    step: float
+    seed: int
+    eta0: np.ndarray
+    nu0: np.ndarray
+    actuators0: np.ndarray | None
+    current: tuple[float, float]
+    controller: Autopilot
+    actuator_faults: tuple[ActuatorFault, ...]
+    sensor_faults: tuple[SensorFault, ...]
+    observers: tuple[ObserverSpec, ...]
+
+
+class _Fields:
+    """Typed access to one TOML table that remembers its path and rejects unknown keys."""
+
+    def __init__(self, data, path: str):
+        if not isinstance(data, dict):
+            raise ScenarioError(f"{path or 'scenario'}: expected a table, got {type(data).__name__}")
+        self.data, self.path, self.used = data, path, set()
+
+    def _name(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default=None):
+        self.used.add(key)
+        return self.data.get(key, default)
+
+    def number(self, key: str, default=None, *, positive: bool = False, minimum: float | None = None) -> float:
+        value = self.raw(key, default)
+        if value is None:
+            raise ScenarioError(f"{self._name(key)}: required number is missing")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ScenarioError(f"{self._name(key)}: expected a finite number, got {value!r}")
+        if positive and not value > 0:
+            raise ScenarioError(f"{self._name(key)}: must be positive, got {value}")
+        if minimum is not None and value < minimum:
+            raise ScenarioError(f"{self._name(key)}: must be >= {minimum}, got {value}")
+        return float(value)
+
+    def text(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            raise ScenarioError(f"{self._name(key)}: expected a string, got {value!r}")
+        if choices is not None and value not in choices:
+            raise ScenarioError(f"{self._name(key)}: unknown value {value!r}; known: {', '.join(choices)}")
+        return value
+
+    def vector(self, key: str, size: int, default=None) -> np.ndarray | None:
+        value = self.raw(key, default)
+        if value is None:
+            return None
+        array = np.asarray(value, dtype=object)
+        if array.shape != (size,) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            raise ScenarioError(f"{self._name(key)}: expected a list of {size} numbers, got {value!r}")
+        result = np.asarray(value, dtype=float)
+        if not np.all(np.isfinite(result)):
+            raise ScenarioError(f"{self._name(key)}: entries must be finite, got {value!r}")
+        return result
+
+    def table(self, key: str) -> _Fields | None:
+        value = self.raw(key)
+        return None if value is None else _Fields(value, self._name(key))
+
+    def tables(self, key: str) -> list[_Fields]:
+        value = self.raw(key, [])
+        if not isinstance(value, list):
+            raise ScenarioError(f"{self._name(key)}: expected an array of tables ([[{key}]])")
+        return [_Fields(item, f"{self._name(key)}[{i}]") for i, item in enumerate(value)]
+
+    def done(self) -> None:
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise ScenarioError(f"{self._name(unknown[0])}: unknown field; known here: {', '.join(sorted(self.used))}")
+
+
+def shipped_scenarios() -> dict[str, Path]:
+    """Example scenarios shipped with uvsym: name -> path."""
+    folder = resources.files("uvsym.sim") / "scenarios"
+    return {Path(str(p)).stem: Path(str(p)) for p in sorted(folder.iterdir(), key=str) if str(p).endswith(".toml")}
+
+
+def load_scenario(source) -> Scenario:
+    """Read and validate a scenario from a TOML file path or the name of a shipped example."""
+    path = Path(source)
+    if not path.exists():
+        shipped = shipped_scenarios()
+        if str(source) not in shipped:
+            raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
+                                   f"shipped: {', '.join(shipped)}")
+        path = shipped[str(source)]
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    return parse_scenario(data, default_name=path.stem)
+
+
+def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
+    """Validate a scenario given as a dict (the parsed TOML)."""
+    top = _Fields(data, "")
+    name = top.text("name", default_name)
+    description = top.text("description", "")
+    vehicle_name = top.text("vehicle")
+    overrides = top.raw("vehicle_parameters", {})
+    if not isinstance(overrides, dict):
+        raise ScenarioError("vehicle_parameters: expected a table of parameter = value")
+    try:
+        model = vehicle(vehicle_name, **overrides)
+    except (ModelError, UnknownNameError) as exc:
+        raise ScenarioError(f"vehicle: {exc}") from None
+    dof, m = model.dof, model.n_inputs
+    duration, step = top.number("duration", positive=True), top.number("step", positive=True)
+    if abs(round(duration / step) * step - duration) > 1e-9 * duration:
+        raise ScenarioError(f"step: {step} s does not divide duration {duration} s")
+    seed = top.raw("seed", 0)
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise ScenarioError(f"seed: expected a non-negative integer, got {seed!r}")
+
+    initial = top.table("initial") or _Fields({}, "initial")
+    eta0 = initial.vector("eta", dof, [0.0] * dof)
+    nu0 = initial.vector("nu", dof, [0.0] * dof)
+    actuators0 = initial.vector("actuators", m)
+    initial.done()
+
+    current = top.table("current") or _Fields({}, "current")
+    V_c = current.number("speed", 0.0, minimum=0.0)
+    beta_c = math.radians(current.number("direction_deg", 0.0))
+    current.done()
+
+    controller = _controller(top.table("controller"), model)
+    actuator_faults, sensor_faults = _faults(top.tables("faults"), model)
+    observers = tuple(_observer(f, dof) for f in top.tables("observers"))
+    top.done()
+    return Scenario(name=name, description=description, model=model, duration=duration, step=step, seed=seed,
+                    eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c), controller=controller,
+                    actuator_faults=actuator_faults, sensor_faults=sensor_faults, observers=observers)
+
+
+def _loop(fields: _Fields | None) -> Loop | None:
+    if fields is None:
+        return None
+    defaults = Loop(reference=0.0, kp=0.0)
+    kwargs = {"reference": fields.number("reference"), "kp": fields.number("kp")}
+    for key in ("ki", "kd", "feedforward", "kp_inner", "theta_max"):
+        kwargs[key] = fields.number(key, getattr(defaults, key))
+    kwargs["i_limit"] = fields.number("i_limit", 1e12, positive=True)
+    fields.done()
+    return Loop(**kwargs)
+
+
+def _controller(fields: _Fields | None, model: Model) -> Autopilot:
+    if fields is None:
+        raise ScenarioError("controller: required table is missing")
+    speed, heading, depth = _loop(fields.table("speed")), _loop(fields.table("heading")), _loop(fields.table("depth"))
+    path = None
+    path_fields = fields.table("path")
+    if path_fields is not None:
+        points = path_fields.raw("waypoints")
+        if not isinstance(points, list) or not all(isinstance(p, list) and len(p) == 2 for p in points):
+            raise ScenarioError("controller.path.waypoints: expected a list of [north, east] pairs (m)")
+        path = LineOfSight(tuple(tuple(float(v) for v in p) for p in points),
+                           lookahead=path_fields.number("lookahead", 10.0, positive=True),
+                           acceptance=path_fields.number("acceptance", 2.0, minimum=0.0),
+                           turn_radius=path_fields.number("turn_radius", 0.0, minimum=0.0))
+        path_fields.done()
+    outputs_fields = fields.table("outputs")
+    if outputs_fields is None:
+        raise ScenarioError("controller.outputs: required table is missing (which inputs each loop drives)")
+    outputs = {}
+    for channel in list(outputs_fields.data):
+        mix = outputs_fields.table(channel)
+        outputs[channel] = {label: mix.number(label) for label in list(mix.data)}
+    model_based = fields.raw("model_based", False)
+    if not isinstance(model_based, bool):
+        raise ScenarioError(f"controller.model_based: expected true or false, got {model_based!r}")
+    fields.done()
+    autopilot = Autopilot(speed=speed, heading=heading, depth=depth, path=path, outputs=outputs,
+                          model_based=model_based)
+    autopilot.check(model.input_labels, model.dof)
+    return autopilot
+
+
+def _profile(fields: _Fields) -> Profile:
+    defaults = Profile()
+    kwargs = {"kind": fields.text("profile", "step")}
+    for key in _PROFILE_KEYS[1:]:
+        if key != "end" or fields.has(key):
+            kwargs[key] = fields.number(key, getattr(defaults, key))
+    return Profile(**kwargs)
+
+
+def _faults(items: list[_Fields], model: Model):
+    actuator, sensor = [], []
+    for fields in items:
+        try:
+            if fields.has("actuator"):
+                label = fields.text("actuator", choices=model.input_labels)
+                actuator.append(ActuatorFault(model.input_labels.index(label), fields.text("kind"),
+                                              fields.number("value"), _profile(fields)))
+            elif fields.has("sensor"):
+                label = fields.text("sensor", choices=model.state_labels)
+                sensor.append(SensorFault(model.state_labels.index(label), fields.text("kind"),
+                                          fields.number("value", 0.0), _profile(fields)))
+            else:
+                raise ScenarioError(f"{fields.path}: give either actuator = <input label> or sensor = <state label>")
+        except FaultError as exc:
+            raise ScenarioError(f"{fields.path}: {exc}") from None
+        fields.done()
+    return tuple(actuator), tuple(sensor)
+
+
+def _observer(fields: _Fields, dof: int) -> ObserverSpec:
+    kind = fields.text("kind", choices=KINDS)
+    spec = ObserverSpec(kind=kind, form=fields.text("form", "paper", choices=FORMS),
+                        time_constant=fields.number("time_constant", positive=True),
+                        tau_d=None if not fields.has("tau_d") else tuple(fields.vector("tau_d", dof)))
+    if kind == "proportional" and spec.tau_d is None:
+        raise ScenarioError(f"{fields.path}.tau_d: the proportional observer's gain design needs a nominal tau_d")
+    fields.done()
+    return spec
