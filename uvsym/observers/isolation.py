@@ -11,8 +11,9 @@ whose error matrix is diagonal (``fit = "exponential"``; for a coupled A its dia
 A matched observer's ``f_bar`` is steady; a mismatched one's wanders with ``tau_d``. Per channel,
 the observer whose ``f_bar`` has the smallest variance over the window names the fault type once
 that variance is below ``threshold`` (paper: 1e-4) and at most ``margin`` times every other
-observer's. A channel is healthy when every observer that can see it has settled at its no-fault
-value (bias: within ``healthy_tolerance`` of 0; constant: of tau_d; proportional: within
+observer's -- unless that observer settled at its no-fault value, which names no fault. A
+channel is also healthy when every observer that can see it has settled at its no-fault value
+(bias: within ``healthy_tolerance`` of 0; constant: of tau_d; proportional: within
 ``healthy_tolerance_p`` of 1). A channel is not observable to an observer while its convergence
 rate (-A_ii) is below ``1 / window_s`` -- for the proportional observer that is Remark 2's
 ``tau_d,i = 0`` made quantitative; such predictions are NaN, never a division by (almost) zero.
@@ -132,7 +133,7 @@ def predicted_faults(observer: ActuatorObserver, K, t: np.ndarray, f_hat: np.nda
         dt = float(t[1] - t[0])
         integral = np.vstack([np.zeros((1, n)), np.cumsum(dt / 2 * (rate[1:] + rate[:-1]), axis=0)])
         span = sliding_window_view(integral, W, axis=0)
-        g = np.exp(np.minimum(span - span[..., -1:], 700.0))  # exp(int_{t_end}^{t_j} A_ii dt) >= 1
+        g = np.exp(np.minimum(span - span[..., -1:], 300.0))  # exp(int_{t_end}^{t_j} A_ii dt) >= 1
         Sg, Sgg, Sf, Sgf = g.sum(-1), (g * g).sum(-1), windows.sum(-1), (g * windows).sum(-1)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             f_bar[W - 1:] = (Sgg * Sf - Sg * Sgf) / (W * Sgg - Sg**2)
@@ -227,5 +228,7 @@ class Isolator:
             if hits.size:
                 h = hits[0]
                 j = int(np.argmin(np.where(finite[h], var[h], np.inf)))
-                self.decisions[label] = ChannelDecision(label, "healthy" if healthy[h] else kinds[j],
-                                                        float(self.t[rows[h]]), float(mean[h, j]), float(var[h, j]))
+                # a matched observer settled at its no-fault value names no fault
+                kind = "healthy" if healthy[h] or settled_neutral[h, j] else kinds[j]
+                self.decisions[label] = ChannelDecision(label, kind, float(self.t[rows[h]]), float(mean[h, j]),
+                                                        float(var[h, j]))

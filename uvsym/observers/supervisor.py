@@ -6,9 +6,11 @@ samples just simulated). Once the isolation has decided enough generalised-force
 its decided channels is faulty -- the channels' predicted faults give the delivered force
 ``tau_hat`` on those rows at the decision instant, ``u = u_e + B^+ (tau_hat - tau_d)`` the
 delivered actuator values (eq. 26, u_e what healthy actuators would deliver) and the severity
-follows. An actuator all of whose channels are decided healthy is healthy. With
-``correct=True`` the command correction (divide by f_p, subtract f_a, stop and redistribute)
-goes back to the loop and acts from the next supervisor period on.
+follows; the fault kind is the one decided on the faulty channel where the actuator has the
+largest share of authority (|B_ia| times its range). An actuator all of whose channels are
+decided healthy is healthy. With ``correct=True`` the command correction (divide by f_p,
+subtract f_a, stop and redistribute) goes back to the loop and acts from the next supervisor
+period on.
 """
 
 from __future__ import annotations
@@ -108,8 +110,11 @@ class FaultDiagnosis:
             tau_hat[row] = {"proportional": decision.f_bar * tau_d[row], "bias": tau_d[row] + decision.f_bar,
                             "constant": decision.f_bar}[decision.kind]
         u_hat = actuator_values(config, tau_hat, tau_d, u_e, rows=[rows[i] for i in decided])
+        # an actuator's fault kind is read on the faulty channel where it has the largest share of authority
+        authority = np.abs(B) * (self.model.u_max - self.model.u_min)
+        share = authority / np.maximum(authority.sum(axis=1, keepdims=True), 1e-300)
         for a in candidates:
-            kinds = [result.decisions[self.channels[i]].kind for i in faulty if support[i, a]]
-            kind = kinds[0]
+            channel = max((i for i in faulty if support[i, a]), key=lambda i: share[i, a])
+            kind = result.decisions[self.channels[channel]].kind
             self.identified[self.labels[a]] = ActuatorFaultEstimate(self.labels[a], kind,
                                                                     severity(kind, u_hat[a], u_e[a]), time_s)

@@ -8,7 +8,7 @@ from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.models.model import Model
-from uvsym.observers import actuator_observer
+from uvsym.observers import ActuatorObserver, actuator_observer
 from uvsym.observers.discrete import discrete_initial_state
 from uvsym.observers.gains import design_gains
 from uvsym.sim.closed_loop import ObserverBlock, build_closed_loop
@@ -17,7 +17,7 @@ from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, grid, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
 
-__all__ = ["simulate", "simulate_scenario", "observer_blocks"]
+__all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers"]
 
 
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
@@ -97,16 +97,20 @@ def _describe(fault, target: str) -> dict:
             "onset_s": profile.onset, "end_s": None if profile.end == float("inf") else profile.end}
 
 
-def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...]) -> tuple[ObserverBlock, ...]:
-    """Actuator-fault observers of the given kinds, with gains designed for their time constants."""
-    labels = FORCE_LABELS[model.dof]
-    blocks = []
+def scenario_observers(model: Model, specs: tuple[ObserverSpec, ...]) -> dict[str, tuple[ActuatorObserver, np.ndarray]]:
+    """kind -> (observer, K): the scenario's observers, with gains designed for their time constants."""
+    observers = {}
     for spec in specs:
         observer = actuator_observer(model, spec.kind, spec.form)
-        K = design_gains(observer, spec.time_constant, spec.tau_d).K
-        units = ("-",) * model.dof if spec.kind == "proportional" else model.force_units
-        blocks.append(ObserverBlock(spec.kind, observer.function, K, labels, units))
-    return tuple(blocks)
+        observers[spec.kind] = (observer, design_gains(observer, spec.time_constant, spec.tau_d).K)
+    return observers
+
+
+def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...]) -> tuple[ObserverBlock, ...]:
+    """The scenario's observers as blocks of the closed loop, named by their kind."""
+    return tuple(ObserverBlock(kind, observer.function, K, FORCE_LABELS[model.dof],
+                               ("-",) * model.dof if kind == "proportional" else model.force_units)
+                 for kind, (observer, K) in scenario_observers(model, specs).items())
 
 
 def simulate_scenario(scenario: Scenario, *, method: str = "fast", supervisor: Supervisor | None = None,
