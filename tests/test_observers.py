@@ -1,0 +1,286 @@
+"""Actuator-fault observers, isolation, identification and correction (core paper, seeds/000)."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from uvsym import fixed_thrusters, vectored_thrusters, vehicle
+from uvsym.errors import IdentifiabilityError, ObserverError
+from uvsym.faults import ActuatorFault, apply_actuator_faults
+from uvsym.observers import KINDS, actuator_observer
+from uvsym.observers.discrete import discrete_initial_state, discrete_observer
+from uvsym.observers.ftc import corrected_commands, linear_correction
+from uvsym.observers.gains import design_gains, unobservable_channels
+from uvsym.observers.identification import ActuatorFaultEstimate, actuator_values, configuration_at
+from uvsym.observers.isolation import IsolationSettings, Isolator, predicted_faults
+from uvsym.observers.supervisor import FaultDiagnosis
+
+OTTER = "otter3dof"  # diagonal M: the paper's Assumption 1 holds
+
+
+def _delivered(kind: str, f, tau_d):
+    """Generalised force a fault of ``kind`` delivers for the desired tau_d (Definition 1)."""
+    return {"proportional": f * tau_d, "bias": tau_d + f, "constant": f}[kind]
+
+
+def _observer_run(model, observer, K, f, tau_d, T: float):
+    """Integrate plant nu and observer x together (CVODES); returns f_hat(T) and f_hat(0)."""
+    n = model.dof
+    nu, x = ca.SX.sym("nu", n), ca.SX.sym("x", n)
+    eta = ca.DM.zeros(n)
+    tau = _delivered(observer.kind, ca.DM(f), ca.DM(tau_d))
+    nu_dot = ca.mtimes(ca.DM(np.linalg.inv(model.M)), tau - model.h(eta, nu))
+    x_dot, f_hat = observer.function(x, eta, nu, tau_d, K)
+    ode = ca.Function("ode", [ca.vertcat(nu, x)], [ca.vertcat(nu_dot, x_dot)])
+    integrator = ca.integrator("I", "cvodes", {"x": ca.vertcat(nu, x), "ode": ode(ca.vertcat(nu, x))}, 0.0, T,
+                               {"abstol": 1e-12, "reltol": 1e-12})
+    nu0 = np.array([1.0, 0.1, 0.05])[:n]
+    x0 = -np.asarray(observer.function(np.zeros(n), eta, nu0, tau_d, K)[1]).ravel()  # f_hat(0) = 0
+    end = np.asarray(integrator(x0=np.r_[nu0, x0])["xf"]).ravel()
+    estimate = ca.Function("f_hat", [nu, x], [f_hat])
+    return np.asarray(estimate(end[:n], end[n:])).ravel(), np.asarray(estimate(nu0, x0)).ravel()
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_observer_error_decays_at_the_designed_rate(kind):
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, kind)
+    tau_d = np.array([60.0, 5.0, 20.0])
+    f = {"proportional": np.array([0.7, 1.0, 0.9]), "bias": np.array([13.0, -2.0, 4.0]),
+         "constant": np.array([30.0, 1.0, -5.0])}[kind]
+    time_constant, T = 0.5, 1.5
+    design = design_gains(observer, time_constant, tau_d)
+    np.testing.assert_allclose(design.rates, 1 / time_constant, rtol=1e-12)
+    f_hat_T, f_hat_0 = _observer_run(model, observer, design.K, f, tau_d, T)
+    np.testing.assert_allclose(f_hat_0, 0.0, atol=1e-12)
+    # e(T) = e(0) exp(-T / time constant) on every channel, e = f - f_hat
+    np.testing.assert_allclose(f - f_hat_T, f * np.exp(-T / time_constant), rtol=1e-6, atol=1e-9)
+
+
+def test_paper_rates_scale_with_the_square_of_the_mass():
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, "bias")
+    A = np.asarray(observer.error_matrix(np.ones(3), np.ones(3)))
+    np.testing.assert_allclose(np.diag(A), -1 / np.diag(model.M) ** 2, rtol=1e-12)
+    prop = actuator_observer(model, "proportional")
+    tau_d = np.array([3.0, 2.0, 5.0])
+    A = np.asarray(prop.error_matrix(tau_d, np.ones(3)))
+    np.testing.assert_allclose(np.diag(A), -(tau_d / np.diag(model.M)) ** 2, rtol=1e-12)
+
+
+def test_L_is_the_jacobian_of_R_not_typed():
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, "proportional")
+    nu, tau_d, K = np.array([1.0, 0.2, 0.1]), np.array([50.0, 4.0, 9.0]), np.array([2.0, 3.0, 4.0])
+    expected = -np.diag(K) @ np.linalg.inv(model.M) @ np.diag(tau_d)  # the paper's L_p for diagonal M
+    np.testing.assert_allclose(np.asarray(observer.L(nu, tau_d, K)), expected, rtol=1e-12)
+
+
+def test_the_paper_proportional_observer_refuses_a_coupled_mass_matrix():
+    model = vehicle("docking_auv")
+    with pytest.raises(ObserverError, match="diagonal mass matrix"):
+        actuator_observer(model, "proportional", "paper")
+    momentum = actuator_observer(model, "proportional", "momentum")
+    tau_d, K = np.array([8.0, 1.0, 2.0, 0.5, 1.0, 0.3]), np.ones(6)
+    np.testing.assert_allclose(np.asarray(momentum.error_matrix(tau_d, K)), -np.diag(K * tau_d**2), atol=1e-9)
+
+
+def test_unknown_kind_and_form_are_refused():
+    with pytest.raises(ObserverError, match="unknown observer kind"):
+        actuator_observer(vehicle(OTTER), "sliding")
+    with pytest.raises(ObserverError, match="unknown observer form"):
+        actuator_observer(vehicle(OTTER), "bias", "symmetric")
+
+
+def test_zero_desired_action_is_reported_not_divided_by():
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, "proportional")
+    tau_d = np.array([40.0, 0.0, 10.0])
+    assert unobservable_channels(observer, tau_d) == (1,)
+    design = design_gains(observer, 0.5, tau_d)
+    assert design.unobservable == (1,) and np.all(np.isfinite(design.K))
+    with pytest.raises(ObserverError, match="nominal tau_d"):
+        design_gains(observer, 0.5)
+
+
+def test_exact_error_dynamics_add_the_dropped_term():
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, "proportional")
+    rng = np.random.default_rng(1)
+    tau_sym, nu_sym = ca.SX.sym("tau_d", 3), ca.SX.sym("nu", 3)
+    K = np.array([0.5, 2.0, 1.0])
+    dR = ca.Function("dR", [nu_sym, tau_sym], [ca.jacobian(observer.R(nu_sym, tau_sym, K), tau_sym)])
+    for _ in range(10):
+        e, f, eta, nu, tau_d, tau_d_dot = (rng.standard_normal(3) for _ in range(6))
+        exact = np.asarray(observer.error_dynamics(e, f, eta, nu, tau_d, tau_d_dot, K)).ravel()
+        paper = np.asarray(observer.error_matrix(tau_d, K)) @ e
+        dropped = np.asarray(dR(nu, tau_d)) @ tau_d_dot
+        np.testing.assert_allclose(exact, paper + dropped, atol=1e-10)
+        assert np.max(np.abs(dropped)) > 1e-3  # the term the paper drops is not zero
+
+
+def test_sampled_data_observer_keeps_a_matched_constant_fault():
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, "bias")
+    K = design_gains(observer, 0.3).K
+    dt, f = 0.01, np.array([5.0, -1.0, 2.0])
+    step = discrete_observer(observer.function, dt)
+    eta, nu = np.zeros(3), np.array([1.0, 0.0, 0.0])
+
+    def tau_d(t):
+        return np.array([50 + 20 * np.sin(0.5 * t), 3 * np.cos(t), 10 * np.sin(0.3 * t)])
+
+    s = discrete_initial_state(observer.function, eta, nu, tau_d(0.0), K)
+    s[:3] = f  # start at the true fault
+    # the plant sees tau_d moving continuously (linearly) between samples, as actuators deliver it
+    x, p, t = ca.SX.sym("nu", 3), ca.SX.sym("p", 6), ca.SX.sym("t")
+    tau = p[:3] + (p[3:] - p[:3]) * t / dt
+    ode = ca.mtimes(ca.DM(np.linalg.inv(model.M)), tau + f - model.h(ca.DM.zeros(3), x))
+    plant = ca.integrator("p", "cvodes", {"x": x, "p": p, "t": t, "ode": ode}, 0.0, dt,
+                          {"abstol": 1e-12, "reltol": 1e-12})
+    # forward Euler on the observer state x, for comparison
+    x_euler = f - np.asarray(observer.function(np.zeros(3), eta, nu, tau_d(0.0), K)[1]).ravel()
+    worst = worst_euler = 0.0
+    for k in range(1, 300):
+        x_dot = np.asarray(observer.function(x_euler, eta, nu, tau_d((k - 1) * dt), K)[0]).ravel()
+        nu = np.asarray(plant(x0=nu, p=np.r_[tau_d((k - 1) * dt), tau_d(k * dt)])["xf"]).ravel()
+        s, f_hat = (np.asarray(v).ravel() for v in step(s, eta, nu, tau_d(k * dt), K))
+        x_euler = x_euler + dt * x_dot
+        f_euler = np.asarray(observer.function(x_euler, eta, nu, tau_d(k * dt), K)[1]).ravel()
+        worst = max(worst, float(np.max(np.abs(f_hat - f))))
+        worst_euler = max(worst_euler, float(np.max(np.abs(f_euler - f))))
+    assert worst < 1e-3  # the motion between samples barely pulls a matched estimate off ...
+    assert worst < worst_euler / 10  # ... an order of magnitude less than with forward Euler
+
+
+def _synthetic(kind_true: str, kind_observer: str, T: float = 6.0, dt: float = 0.01):
+    """Estimates of an exactly exponential matched observer, or of the wrong one, with varying tau_d."""
+    model = vehicle(OTTER)
+    observer = actuator_observer(model, kind_observer)
+    t = np.arange(0.0, T, dt)
+    tau_d = np.column_stack([50 + 20 * np.sin(0.7 * t), 5 + 2 * np.cos(0.5 * t), 10 + 4 * np.sin(0.9 * t)])
+    K = design_gains(observer, 0.3, tau_d[0]).K
+    f_p, f_a = np.array([0.8, 1.0, 1.0]), np.array([13.0, 0.0, 0.0])
+    if kind_true == "bias":
+        f_true = f_a if kind_observer == "bias" else (tau_d + f_a) / tau_d
+    else:
+        f_true = f_p if kind_observer == "proportional" else (f_p - 1) * tau_d
+    # integrate e' = A(t) e exactly for the matched case; the mismatched "fault" drifts with tau_d
+    f_hat = np.zeros_like(tau_d)
+    e = f_true[0] if np.ndim(f_true) == 2 else f_true.copy()
+    for k in range(len(t)):
+        target = f_true[k] if np.ndim(f_true) == 2 else f_true
+        if k:
+            A = np.diag(np.asarray(observer.error_matrix(tau_d[k], K)))
+            e = (target - f_hat[k - 1]) * np.exp(A * dt)
+        f_hat[k] = target - e
+    return observer, K, t, f_hat, tau_d
+
+
+def test_matched_observer_settles_and_the_wrong_one_does_not():
+    settings = IsolationSettings()
+    observer, K, t, f_hat, tau_d = _synthetic("bias", "bias")
+    matched, _ = predicted_faults(observer, K, t, f_hat, tau_d, settings)
+    wrong_observer, K_w, t, f_hat_w, tau_d = _synthetic("bias", "proportional")
+    wrong, _ = predicted_faults(wrong_observer, K_w, t, f_hat_w, tau_d, settings)
+    late = t > 3.0
+    assert np.nanvar(matched[late, 0]) < 1e-8
+    np.testing.assert_allclose(matched[late, 0], 13.0, atol=1e-6)
+    assert np.nanvar(wrong[late, 0]) > 1e-3  # (tau_d + 13) / tau_d keeps moving with tau_d
+
+
+def test_isolator_fed_in_chunks_equals_one_pass():
+    observers = {}
+    data = {}
+    for kind in ("bias", "proportional"):
+        observer, K, t, f_hat, tau_d = _synthetic("bias", kind)
+        observers[kind] = (observer, K)
+        data[kind] = f_hat
+    labels = ("X", "Y", "N")
+    whole = Isolator(observers, labels).update(t, data, tau_d)
+    chunked = Isolator(observers, labels)
+    for start in range(0, len(t), 37):
+        sl = slice(start, start + 37)
+        result = chunked.update(t[sl], {k: v[sl] for k, v in data.items()}, tau_d[sl])
+    for kind in observers:
+        np.testing.assert_allclose(result.f_bar[kind], whole.f_bar[kind], rtol=1e-9, atol=1e-12, equal_nan=True)
+        np.testing.assert_allclose(result.variance[kind], whole.variance[kind], rtol=1e-6, atol=1e-15,
+                                   equal_nan=True)
+    assert result.decisions["X"].kind == whole.decisions["X"].kind == "bias"
+
+
+@pytest.mark.parametrize("config", [
+    fixed_thrusters([0.0, np.pi / 2, np.pi], [[-1.0, 0.3, 0.0], [0.0, 0.5, 0.0], [1.0, -0.3, 0.0]],
+                    [[0.5, 0.0, 0.0], [-0.5, 0.2, 0.0]]),
+    vectored_thrusters([0.3, -0.2], [1.2, 1.4], [[-1.0, 0.3, 0.1], [-1.0, -0.3, 0.1]], ["ex", "both"]),
+    configuration_at(vehicle("docking_auv"), np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), np.zeros(4)),
+], ids=["fixed", "vectored", "fins"])
+def test_identification_round_trips_u_tau_u(config):
+    u = np.linspace(0.3, 1.7, config.B.shape[1])
+    np.testing.assert_allclose(actuator_values(config, config.B @ u), u, rtol=1e-10)
+
+
+def test_identification_refuses_a_configuration_it_cannot_invert():
+    crowded = fixed_thrusters([0.0, 0.5, 1.0, 1.5], [[-1.0, 0.3, 0.0], [0.0, 0.5, 0.0], [1.0, -0.3, 0.0],
+                                                     [0.5, 0.5, 0.0]], [])
+    with pytest.raises(IdentifiabilityError, match="traded against"):
+        actuator_values(crowded, np.ones(6))
+
+
+@pytest.mark.parametrize("kind, value", [("proportional", 0.7), ("bias", 13.0), ("bias", -0.05)])
+def test_correction_restores_the_desired_actuation(kind, value):
+    model = vehicle("docking_auv")
+    labels = model.input_labels
+    u_d = np.array([20.0, 0.02, -0.05, -0.05])
+    actuator = 0 if value == 13.0 else 2
+    fault = ActuatorFault(actuator, kind, value)
+    estimate = {labels[actuator]: ActuatorFaultEstimate(labels[actuator], kind, value, 0.0)}
+    B = configuration_at(model, np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), u_d).B
+    u_star = corrected_commands(u_d, estimate, labels, B, model.u_min, model.u_max)
+    delivered = np.asarray(apply_actuator_faults(ca.DM(u_star), 0.0, (fault,))).ravel()
+    np.testing.assert_allclose(delivered, u_d, rtol=1e-12, atol=1e-12)
+
+
+def test_a_stuck_actuator_is_stopped_and_its_share_redistributed():
+    config = fixed_thrusters([0.0, 0.0, np.pi / 2], [[-1.0, 0.3, 0.0], [-1.0, -0.3, 0.0], [0.0, 0.0, 0.0]], [])
+    labels = config.labels
+    u_d = np.array([10.0, 10.0, 2.0])
+    estimate = {labels[1]: ActuatorFaultEstimate(labels[1], "constant", 0.0, 0.0)}
+    correction = linear_correction(estimate, labels, config.B)
+    u_star = correction.S @ u_d + correction.o
+    assert u_star[1] == 0.0
+    # the others deliver the closest force they can: the residual is orthogonal to their columns
+    residual = config.B @ u_star - config.B @ u_d
+    np.testing.assert_allclose(config.B[:, [0, 2]].T @ residual, 0.0, atol=1e-9)
+    assert np.linalg.norm(residual) < np.linalg.norm(config.B[:, 1] * u_d[1])  # better than doing nothing
+
+
+def test_correction_keeps_commands_within_bounds():
+    model = vehicle("docking_auv")
+    labels = model.input_labels
+    u_d = np.array([95.0, 0.0, 0.2, 0.2])
+    estimate = {"delta_ru": ActuatorFaultEstimate("delta_ru", "proportional", 0.5, 0.0)}
+    B = configuration_at(model, np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), u_d).B
+    u_star = corrected_commands(u_d, estimate, labels, B, model.u_min, model.u_max)
+    assert np.all(u_star <= model.u_max + 1e-9) and np.all(u_star >= model.u_min - 1e-9)
+    assert u_star[3] > u_d[3]  # the healthy lower rudder takes over what the upper cannot deliver
+
+
+def test_diagnosis_in_the_loop_identifies_the_docking_faults():
+    from dataclasses import replace
+
+    from uvsym.sim.scenario import load_scenario
+    from uvsym.sim.simulation import scenario_observers, simulate_scenario
+
+    scenario = replace(load_scenario("docking_faults"), duration=6.0)
+    diagnosis = FaultDiagnosis(scenario.model, scenario_observers(scenario.model, scenario.observers))
+    simulate_scenario(scenario, supervisor=diagnosis)
+    assert diagnosis.identified["X"].kind == "bias"
+    assert abs(diagnosis.identified["X"].value - 13.0) < 0.01
+    for rudder in ("delta_ru", "delta_rd"):
+        assert diagnosis.identified[rudder].kind == "proportional"
+        assert abs(diagnosis.identified[rudder].value - 0.8) < 0.001
+    assert list(diagnosis.healthy) == ["delta_e"]
+    assert diagnosis.isolation_time_s < 5.0
