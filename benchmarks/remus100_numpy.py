@@ -41,13 +41,16 @@ class Remus100Numpy:
         self.cd_2d = hoerner_cd(self.p("diam"), self.p("diam"))
 
     def nu_dot(self, eta, nu, u):
-        p, M = self.p, self.M
-        rho, L, diam = p("rho"), p("L"), p("diam")
+        """Accelerations (6,) for actuator values u = (delta_r, delta_s, n)."""
+        return self.Minv @ (self.actuation(nu, u) + self.hull(eta, nu))
+
+    def actuation(self, nu, u):
+        """tau (6,) of the rudder, stern plane and propeller."""
+        p, L, rho = self.p, self.p("L"), self.p("rho")
         delta_r = np.clip(u[0], -p("deltaMax_r"), p("deltaMax_r"))
         delta_s = np.clip(u[1], -p("deltaMax_s"), p("deltaMax_s"))
         n = np.clip(u[2], -p("nMax"), p("nMax"))
         U = math.sqrt(nu[0] ** 2 + nu[1] ** 2 + nu[2] ** 2)
-        alpha = math.atan2(nu[2], nu[0])
         n_rps, D = n / 60, p("D_prop")
         Va = p("wake_factor") * U
         if n_rps > 0:
@@ -58,6 +61,18 @@ class Remus100Numpy:
         else:
             X_prop = rho * D**4 * p("KT_0") * abs(n_rps) * n_rps
             K_prop = rho * D**5 * p("KQ_0") * abs(n_rps) * n_rps
+        U_rh2, U_rv2 = nu[0] ** 2 + nu[1] ** 2, nu[0] ** 2 + nu[2] ** 2
+        Y_r = -0.5 * rho * U_rh2 * p("A_r") * p("CL_delta_r") * delta_r
+        Z_s = -0.5 * rho * U_rv2 * p("A_s") * p("CL_delta_s") * delta_s
+        return np.array([(1 - p("t_prop")) * X_prop + Y_r * delta_r + Z_s * delta_s, Y_r, Z_s,
+                         p("torque_scale") * K_prop, L / 2 * Z_s, -L / 2 * Y_r])
+
+    def hull(self, eta, nu):
+        """Every hull force (6,) on the right-hand side: lift, drag, cross-flow, -(C + D) nu - g."""
+        p, M = self.p, self.M
+        rho, L, diam = p("rho"), p("L"), p("diam")
+        U = math.sqrt(nu[0] ** 2 + nu[1] ** 2 + nu[2] ** 2)
+        alpha = math.atan2(nu[2], nu[0])
         CA = _m2c(self.MA, nu)
         for i, j in MUNK_FREE_ENTRIES:
             CA[i, j] = 0
@@ -83,9 +98,4 @@ class Remus100Numpy:
         phi, theta = eta[3], eta[4]
         zgW = p("r_bg")[2] * self.W
         g = np.array([0, 0, 0, zgW * math.cos(theta) * math.sin(phi), zgW * math.sin(theta), 0])
-        U_rh2, U_rv2 = nu[0] ** 2 + nu[1] ** 2, nu[0] ** 2 + nu[2] ** 2
-        Y_r = -0.5 * rho * U_rh2 * p("A_r") * p("CL_delta_r") * delta_r
-        Z_s = -0.5 * rho * U_rv2 * p("A_s") * p("CL_delta_s") * delta_s
-        tau = np.array([(1 - p("t_prop")) * X_prop + Y_r * delta_r + Z_s * delta_s, Y_r, Z_s,
-                        p("torque_scale") * K_prop, L / 2 * Z_s, -L / 2 * Y_r])
-        return self.Minv @ (tau + tau_ld + tau_cf - (C + D_mat) @ nu - g)
+        return tau_ld + tau_cf - (C + D_mat) @ nu - g
