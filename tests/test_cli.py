@@ -67,3 +67,33 @@ def test_committed_models_report_is_current(tmp_path):
     assert main(["report", "models", "--out", str(tmp_path)]) == 0
     for name in ("report.md", "results.json"):
         assert (tmp_path / "models" / name).read_text() == (committed / name).read_text(), f"stale {name}"
+
+
+def test_simulate_lists_the_shipped_scenarios(capsys):
+    assert main(["simulate", "--list"]) == 0
+    out = capsys.readouterr().out
+    assert "docking_faults" in out and "remus100_stern_plane_bias" in out
+
+
+def test_simulate_writes_result_and_figure(tmp_path, capsys):
+    scenario = tmp_path / "short.toml"
+    text = (Path(uvsym.__file__).parent / "sim" / "scenarios" / "docking_faults.toml").read_text()
+    scenario.write_text(text.replace("duration = 90.0", "duration = 2.0"))
+    out_file = tmp_path / "run.npz"
+    assert main(["simulate", str(scenario), "--out", str(out_file), "--plot"]) == 0
+    printed = capsys.readouterr().out
+    assert "simulated s per wall s" in printed and "final state: x = " in printed
+    from uvsym.sim import SimResult
+
+    result = SimResult.load(out_file)
+    assert result.t[-1] == pytest.approx(2.0) and result.meta["scenario"] == "docking_faults"
+    assert (tmp_path / "run.svg").read_text().startswith("<?xml")
+
+
+def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path):
+    scenario = tmp_path / "bad.toml"
+    text = (Path(uvsym.__file__).parent / "sim" / "scenarios" / "docking_faults.toml").read_text()
+    scenario.write_text(text.replace('kind = "bias"            # proportional', 'kind = "wobble"  #'))
+    result = run("simulate", str(scenario))
+    assert result.returncode == 2
+    assert "faults[0]" in result.stderr and "wobble" in result.stderr and "Traceback" not in result.stderr
