@@ -10,7 +10,7 @@ from uvsym import fixed_thrusters, vectored_thrusters, vehicle
 from uvsym.errors import IdentifiabilityError, ObserverError
 from uvsym.faults import ActuatorFault, apply_actuator_faults
 from uvsym.observers import KINDS, actuator_observer
-from uvsym.observers.discrete import discrete_initial_state, discrete_observer
+from uvsym.observers.discrete import sampled_observer
 from uvsym.observers.ftc import corrected_commands, linear_correction
 from uvsym.observers.gains import design_gains, unobservable_channels
 from uvsym.observers.identification import ActuatorFaultEstimate, actuator_values, configuration_at
@@ -126,13 +126,14 @@ def test_sampled_data_observer_keeps_a_matched_constant_fault():
     observer = actuator_observer(model, "bias")
     K = design_gains(observer, 0.3).K
     dt, f = 0.01, np.array([5.0, -1.0, 2.0])
-    step = discrete_observer(observer.function, dt)
+    sampled = sampled_observer(observer.function, dt)
+    step = sampled.step
     eta, nu = np.zeros(3), np.array([1.0, 0.0, 0.0])
 
     def tau_d(t):
         return np.array([50 + 20 * np.sin(0.5 * t), 3 * np.cos(t), 10 * np.sin(0.3 * t)])
 
-    s = discrete_initial_state(observer.function, eta, nu, tau_d(0.0), K)
+    s = sampled.initial_state(eta, nu, tau_d(0.0), K)
     s[:3] = f  # start at the true fault
     # the plant sees tau_d moving continuously (linearly) between samples, as actuators deliver it
     x, p, t = ca.SX.sym("nu", 3), ca.SX.sym("p", 6), ca.SX.sym("t")

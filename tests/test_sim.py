@@ -216,3 +216,11 @@ def test_bad_simulation_arguments_are_refused(docking):
         simulate(docking.model, docking.controller, duration=1.0, dt=0.3, eta0=docking.eta0, nu0=docking.nu0)
     with pytest.raises(SimulationError, match="eta0"):
         simulate(docking.model, docking.controller, duration=1.0, dt=0.1, eta0=[0.0], nu0=docking.nu0)
+
+
+def test_the_compiled_fast_path_leaves_the_floating_point_state_alone(docking):
+    import sys
+
+    simulate_scenario(_short(docking, 0.5), compiled=True)
+    tiny = sys.float_info.min / 4  # subnormal: flushed to zero if a library switched on FTZ/DAZ
+    assert tiny > 0.0 and tiny * 2 > tiny

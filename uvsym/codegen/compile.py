@@ -18,10 +18,11 @@ import casadi as ca
 
 from uvsym.errors import CodegenError
 
-__all__ = ["DEFAULT_FLAGS", "FAST_FLAGS", "find_compiler", "compile_function"]
+__all__ = ["DEFAULT_FLAGS", "find_compiler", "compile_function"]
 
-DEFAULT_FLAGS = ("-O3", "-march=native", "-fPIC", "-shared")
-FAST_FLAGS = DEFAULT_FLAGS + ("-ffast-math",)
+# No -ffast-math: a shared library built with it switches the whole process to flush-to-zero
+# on load (crtfastmath), which silently changes every other float computation in Python.
+DEFAULT_FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fPIC", "-shared")
 _BUILD_DIR: Path | None = None
 _COUNTER = itertools.count()
 

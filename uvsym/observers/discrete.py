@@ -13,20 +13,36 @@ which keeps a matched, constant fault a fixed point to third order in dt (forwar
 leaves an offset of order ``dt M nu''``) and is stable for any gain: the proportional
 observer's rate ``k_i tau_d,i^2`` grows without bound with the desired action, which an
 explicit step would not survive. The state carries what sample k-1 contributed:
-``s = [f_hat (n); vec(P) (n n); q (n); vec(L) (n n); nu (n)]``.
+``s = [f_hat (n); P's non-zeros; q (n); L's non-zeros; nu (n)]``.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import casadi as ca
 import numpy as np
 
-__all__ = ["discrete_observer", "discrete_initial_state", "discrete_state_size"]
+__all__ = ["SampledObserver", "sampled_observer"]
 
 
-def discrete_state_size(n: int) -> int:
-    """Entries of the sampled-data observer state for n channels."""
-    return 3 * n + 2 * n * n
+def _drop_residue(matrix: ca.SX, inputs: list, samples: int = 8, rtol: float = 1e-12) -> ca.SX:
+    """``matrix`` without the entries that are rounding residue at every sampled input.
+
+    Products such as ``M M^-1`` leave entries like ``1e-17 k tau`` that are zero in exact
+    arithmetic; an entry whose value stays below ``rtol`` times the matrix's largest at every
+    random sample is dropped (made structurally zero), so that a diagonal matrix is seen as one.
+    """
+    probe = ca.Function("probe", inputs, [matrix])
+    rng = np.random.default_rng(0)
+    largest = np.zeros(matrix.shape)
+    for _ in range(samples):
+        value = np.abs(np.asarray(probe(*[rng.uniform(0.5, 2.0, v.shape) for v in inputs])))
+        largest = np.maximum(largest, value / max(value.max(), 1e-300))
+    cleaned = ca.SX(*matrix.shape)
+    for i, j in zip(*np.nonzero(largest > rtol)):
+        cleaned[int(i), int(j)] = matrix[int(i), int(j)]
+    return cleaned
 
 
 def _pieces(function: ca.Function) -> ca.Function:
@@ -36,35 +52,56 @@ def _pieces(function: ca.Function) -> ca.Function:
     tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
     R = -function(ca.SX.zeros(n), eta, nu, tau_d, K)[1]
     phi = function(f_hat + R, eta, nu, tau_d, K)[0]
-    P = ca.jacobian(phi, f_hat)
+    inputs = [eta, nu, tau_d, K]
+    P = _drop_residue(ca.jacobian(phi, f_hat), inputs)
     q = ca.substitute(phi, f_hat, ca.DM.zeros(n))
-    return ca.Function("pieces", [eta, nu, tau_d, K], [P, q, ca.jacobian(R, nu)],
-                       ["eta", "nu", "tau_d", "K"], ["P", "q", "L"])
+    L = _drop_residue(ca.jacobian(R, nu), inputs)
+    return ca.Function("pieces", inputs, [P, q, L], ["eta", "nu", "tau_d", "K"], ["P", "q", "L"])
 
 
-def discrete_observer(function: ca.Function, dt: float) -> ca.Function:
-    """``(s, eta, nu, tau_d, K) -> (s_next, f_hat)``: one sample of the observer (module docstring).
+@dataclass(frozen=True)
+class SampledObserver:
+    """The sampled-data observer: ``step(s, eta, nu, tau_d, K) -> (s_next, f_hat)``.
 
-    s holds sample k-1; eta, nu, tau_d are sample k's; f_hat is the estimate at sample k.
+    s holds sample k-1 (module docstring; P and L by their non-zeros only); eta, nu, tau_d are
+    sample k's and f_hat is the estimate at sample k.
     """
+
+    step: ca.Function
+    pieces: ca.Function
+    n: int
+    nnz_P: int
+    nnz_L: int
+
+    @property
+    def state_size(self) -> int:
+        return 3 * self.n + self.nnz_P + self.nnz_L
+
+    def initial_state(self, eta, nu, tau_d, K) -> np.ndarray:
+        """The state before the first sample: f_hat = 0 and sample k-1 equal to the first sample."""
+        P, q, L = self.pieces(eta, nu, tau_d, K)
+        return np.concatenate([np.zeros(self.n), np.asarray(P.nonzeros()), np.asarray(q).ravel(),
+                               np.asarray(L.nonzeros()), np.asarray(nu, dtype=float).ravel()])
+
+
+def sampled_observer(function: ca.Function, dt: float) -> SampledObserver:
+    """The sampled-data form (module docstring) of ``function`` for the sample period dt (s)."""
     n = function.size1_in("x")
     pieces = _pieces(function)
-    s, eta, nu = ca.SX.sym("s", discrete_state_size(n)), ca.SX.sym("eta", n), ca.SX.sym("nu", n)
+    sp_P, sp_L = pieces.sparsity_out("P"), pieces.sparsity_out("L")
+    nnz_P, nnz_L = sp_P.nnz(), sp_L.nnz()
+    s, eta, nu = ca.SX.sym("s", 3 * n + nnz_P + nnz_L), ca.SX.sym("eta", n), ca.SX.sym("nu", n)
     tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
-    f_prev, rest = s[:n], s[n:]
-    P_prev, q_prev = ca.reshape(rest[:n * n], n, n), rest[n * n:n * n + n]
-    L_prev, nu_prev = ca.reshape(rest[n * n + n:2 * n * n + n], n, n), rest[2 * n * n + n:]
+    f_prev, P_prev = s[:n], ca.SX(sp_P, s[n:n + nnz_P])
+    q_prev = s[n + nnz_P:2 * n + nnz_P]
+    L_prev, nu_prev = ca.SX(sp_L, s[2 * n + nnz_P:2 * n + nnz_P + nnz_L]), s[2 * n + nnz_P + nnz_L:]
     P, q, L = pieces(eta, nu, tau_d, K)
     rhs = f_prev + dt / 2 * (ca.mtimes(P_prev, f_prev) + q_prev + q) - ca.mtimes((L_prev + L) / 2, nu - nu_prev)
-    f_hat = ca.solve(ca.SX.eye(n) - dt / 2 * P, rhs)
-    s_next = ca.vertcat(f_hat, ca.vec(P), q, ca.vec(L), nu)
-    return ca.Function("observer_step", [s, eta, nu, tau_d, K], [s_next, f_hat],
+    lhs = ca.SX.eye(n) - dt / 2 * P
+    diagonal = set(zip(*sp_P.get_triplet())) <= {(i, i) for i in range(n)}
+    f_hat = rhs / ca.diag(lhs) if diagonal else ca.solve(lhs, rhs)
+    s_next = ca.densify(ca.vertcat(f_hat, ca.vertcat(ca.SX(0, 1), *P.nonzeros()), q,
+                                   ca.vertcat(ca.SX(0, 1), *L.nonzeros()), nu))
+    step = ca.Function("observer_step", [s, eta, nu, tau_d, K], [s_next, f_hat],
                        ["s", "eta", "nu", "tau_d", "K"], ["s_next", "f_hat"])
-
-
-def discrete_initial_state(function: ca.Function, eta, nu, tau_d, K) -> np.ndarray:
-    """The state before the first sample: f_hat = 0, and sample k-1 taken equal to the first sample."""
-    n = function.size1_in("x")
-    P, q, L = (np.asarray(v) for v in _pieces(function)(eta, nu, tau_d, K))
-    return np.concatenate([np.zeros(n), P.ravel(order="F"), q.ravel(), L.ravel(order="F"),
-                           np.asarray(nu, dtype=float).ravel()])
+    return SampledObserver(step=step, pieces=pieces, n=n, nnz_P=nnz_P, nnz_L=nnz_L)

@@ -25,7 +25,7 @@ from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
 from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
-from uvsym.observers.discrete import discrete_observer, discrete_state_size
+from uvsym.observers.discrete import SampledObserver, sampled_observer
 from uvsym.sim.controllers import Autopilot
 
 __all__ = ["ObserverBlock", "ClosedLoop", "build_closed_loop", "rk4"]
@@ -45,11 +45,6 @@ class ObserverBlock:
     labels: tuple[str, ...]
     units: tuple[str, ...]
 
-    @property
-    def n_state(self) -> int:
-        """Entries of its sampled-data state."""
-        return discrete_state_size(self.function.size1_in("x"))
-
 
 @dataclass(frozen=True)
 class ClosedLoop:
@@ -58,7 +53,8 @@ class ClosedLoop:
     discrete(z, w) -> (z_disc, u_cmd, out): z_disc the next [xc; xo; a_expected; held], out the
     logged signals; plant_ode(s, u_cmd, env, t) -> s_dot for s = [x; a]; step(z, w) -> (z_next, out)
     the fixed-step path (discrete part, then ``substeps`` RK4 steps of the plant). ``layout`` maps
-    the parts of z (x, a, xc, xo, a_expected, held) to their slices.
+    the parts of z (x, a, xc, xo, a_expected, held) to their slices; ``sampled`` the observers'
+    sampled-data forms by name, ``observer_slices`` their states within xo.
     """
 
     model: Model
@@ -72,6 +68,7 @@ class ClosedLoop:
     step: ca.Function
     layout: dict
     observer_slices: dict
+    sampled: dict[str, SampledObserver]
     signals: dict  # name -> (slice of out, labels, units)
 
 
@@ -105,7 +102,8 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     controller.check(model.input_labels, model.dof)
     n, m = 2 * model.dof, model.n_inputs
     n_c = len(controller.state_labels)
-    n_o = sum(obs.n_state for obs in observers)
+    sampled = {obs.name: sampled_observer(obs.function, dt) for obs in observers}
+    n_o = sum(s.state_size for s in sampled.values())
     layout, start = {}, 0
     for part, size in (("x", n), ("a", m), ("xc", n_c), ("xo", n_o), ("a_expected", m), ("held", n)):
         layout[part], start = slice(start, start + size), start + size
@@ -126,12 +124,12 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
 
     xo_next, estimates, observer_slices, start = [], [], {}, 0
     for obs in observers:
-        s_next, f_hat = discrete_observer(obs.function, dt)(xo[start:start + obs.n_state], eta_y, nu_y, tau_d,
-                                                            ca.DM(obs.K))
+        size = sampled[obs.name].state_size
+        s_next, f_hat = sampled[obs.name].step(xo[start:start + size], eta_y, nu_y, tau_d, ca.DM(obs.K))
         xo_next.append(s_next)
         estimates.append(f_hat)
-        observer_slices[obs.name] = slice(start, start + obs.n_state)
-        start += obs.n_state
+        observer_slices[obs.name] = slice(start, start + size)
+        start += size
 
     a_now = z[layout["a"]]
     out_parts = {
@@ -168,4 +166,4 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                        {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
                       plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
-                      signals=signals)
+                      sampled=sampled, signals=signals)

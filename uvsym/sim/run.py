@@ -21,7 +21,6 @@ import casadi as ca
 import numpy as np
 
 from uvsym.codegen import compile_function, find_compiler
-from uvsym.codegen.compile import FAST_FLAGS
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.observers.ftc import Correction
 from uvsym.sim.closed_loop import ClosedLoop
@@ -90,7 +89,7 @@ def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled:
         rollers = {chunk: loop.step.mapaccum("roll", chunk)}
         if compiled and find_compiler() is not None:
             try:
-                rollers[chunk] = compile_function(rollers[chunk], FAST_FLAGS)
+                rollers[chunk] = compile_function(rollers[chunk])
             except CodegenError as exc:
                 warnings.warn(f"running the fast path interpreted: {exc}", stacklevel=3)
 

@@ -9,7 +9,6 @@ from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.models.model import Model
 from uvsym.observers import ActuatorObserver, actuator_observer
-from uvsym.observers.discrete import discrete_initial_state
 from uvsym.observers.gains import design_gains
 from uvsym.sim.closed_loop import ObserverBlock, build_closed_loop
 from uvsym.sim.controllers import Autopilot
@@ -70,8 +69,8 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     tau_d0 = np.asarray(model.tau(x0[:dof], x0[dof:], a0, 0.0, 0.0)).ravel()
     for obs in observers:
         sl = loop.observer_slices[obs.name]
-        z0[lay["xo"].start + sl.start:lay["xo"].start + sl.stop] = discrete_initial_state(
-            obs.function, x0[:dof], x0[dof:], tau_d0, obs.K)
+        z0[lay["xo"].start + sl.start:lay["xo"].start + sl.stop] = loop.sampled[obs.name].initial_state(
+            x0[:dof], x0[dof:], tau_d0, obs.K)
 
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
                                      compiled=compiled, progress=progress)
