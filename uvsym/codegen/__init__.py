@@ -1,5 +1,5 @@
 """C code generation: generate sources from CasADi Functions, compile them, load them back."""
 
-from uvsym.codegen.compile import compile_function, find_compiler
+from uvsym.codegen.compile import compile_function, compile_roll, find_compiler
 
-__all__ = ["compile_function", "find_compiler"]
+__all__ = ["compile_function", "compile_roll", "find_compiler"]

@@ -153,7 +153,7 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     z_disc = ca.vertcat(xc_next, *xo_next, a_expected_next, held_next)
     # dense outputs: buffers and mapaccum read them as plain arrays
     z_disc, u_cmd, out = ca.densify(z_disc), ca.densify(u_cmd), ca.densify(out)
-    discrete = ca.Function("discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
+    discrete = ca.Function("closed_loop_discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
 
     s, uc, env, ts = ca.SX.sym("s", n_s), ca.SX.sym("u_cmd", m), ca.SX.sym("env", 2), ca.SX.sym("t")
     applied = apply_actuator_faults(s[n:], ts, actuator_faults)
@@ -162,8 +162,9 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
 
     env_step = ca.vertcat(V_c, beta_c) if current is None else ca.DM(current)
     s_next = rk4(plant_ode, z[:n_s], dt, substeps, u_cmd, env_step, t=t)
-    step = ca.Function("step", [z, w], [ca.densify(ca.vertcat(s_next, z_disc)), out], ["z", "w"], ["z_next", "out"],
-                       {"cse": True})
+    # named apart from libc's regex step(): a C caller of an exported "step" may reach that one
+    step = ca.Function("closed_loop_step", [z, w], [ca.densify(ca.vertcat(s_next, z_disc)), out],
+                       ["z", "w"], ["z_next", "out"], {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
                       plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
                       sampled=sampled, signals=signals)

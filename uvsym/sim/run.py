@@ -1,8 +1,8 @@
 """``simulate``: run a closed loop on a grid with a chosen method, in supervisor-sized chunks.
 
-Methods: ``fast`` rolls the symbolic fixed-step RK4 closed-loop step with ``mapaccum``, compiled
-with the system C compiler when there is one (interpreted otherwise). ``cvodes``, ``idas``,
-``rk`` and ``collocation`` integrate the plant over each sample with CasADi's integrators
+Methods: ``fast`` rolls the symbolic fixed-step RK4 closed-loop step in a C loop compiled with
+the system C compiler when there is one (otherwise interpreted, with ``mapaccum``). ``cvodes``,
+``idas``, ``rk`` and ``collocation`` integrate the plant over each sample with CasADi's integrators
 (``integrator(name, plugin, dae, t0, grid)``) while the same discrete part runs in between.
 
 A supervisor (isolation, identification, correction) runs every ``supervisor.period`` seconds on
@@ -20,7 +20,7 @@ from typing import Protocol
 import casadi as ca
 import numpy as np
 
-from uvsym.codegen import compile_function, find_compiler
+from uvsym.codegen import compile_roll, find_compiler
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.observers.ftc import Correction
 from uvsym.sim.closed_loop import ClosedLoop
@@ -29,7 +29,9 @@ from uvsym.sim.result import Signal, SimResult
 __all__ = ["METHODS", "Correction", "Supervisor", "run_closed_loop"]
 
 METHODS = ("fast", "cvodes", "idas", "rk", "collocation")
-DEFAULT_CHUNK = 2000
+# samples per call between progress reports (no supervisor): the fast path pays per call, the
+# integrators step in Python anyway
+CHUNK = {"fast": 10000, "integrator": 100}
 ACCURATE = {"cvodes": {"abstol": 1e-12, "reltol": 1e-12}, "idas": {"abstol": 1e-12, "reltol": 1e-12}}
 
 
@@ -45,71 +47,72 @@ class Supervisor(Protocol):
 def run_closed_loop(loop: ClosedLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
                     compiled: bool = True, progress=None) -> tuple[SimResult, dict]:
-    """Simulate ``len(W.T) - 1`` samples from z0; W: (n_w, N + 1) per-sample inputs.
+    """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
 
-    The correction rows of W are overwritten by the supervisor's corrections. Returns the result
-    (samples at every grid time, meta without the caller's part) and timing information.
+    The correction columns of W are overwritten by the supervisor's corrections. Returns the
+    result (samples at every grid time, meta without the caller's part) and timing information.
     """
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
     m = loop.model.n_inputs
-    N = W.shape[1] - 1
-    chunk = DEFAULT_CHUNK if supervisor is None else max(1, round(supervisor.period / loop.dt))
-    n_out = loop.discrete.size1_out("out")
-    outputs = np.empty((N + 1, n_out))
-    correction_rows = slice(loop.n_w - m * m - m, loop.n_w)
+    N = W.shape[0] - 1
+    if supervisor is not None:
+        chunk = max(1, round(supervisor.period / loop.dt))
+    else:
+        chunk = CHUNK["fast" if method == "fast" else "integrator"]
+    W = np.ascontiguousarray(W, dtype=float)
+    outputs = np.empty((N + 1, loop.discrete.size1_out("out")))
+    correction_columns = slice(loop.n_w - m * m - m, loop.n_w)
     advance, build_s = _stepper(loop, method, min(chunk, N), options or {}, compiled)
     z = np.asarray(z0, dtype=float)
     started = time.perf_counter()
     for start in range(0, N, chunk):
         k = min(chunk, N - start)
-        z, outputs[start:start + k] = advance(z, W[:, start:start + k])
+        z = advance(z, W[start:start + k], outputs[start:start + k])
         if not np.all(np.isfinite(z)):
             raise SimulationError(f"state became non-finite between t = {start * loop.dt:.6g} s and "
                                   f"t = {(start + k) * loop.dt:.6g} s ({method}); try a smaller step")
         if supervisor is not None:
             signals = {name: outputs[start:start + k, sl] for name, (sl, _, _) in loop.signals.items()}
-            correction = supervisor.update(W[0, start:start + k], signals)
+            correction = supervisor.update(W[start:start + k, 0], signals)
             if correction is not None:
-                W[correction_rows, start + k:] = np.concatenate(
-                    [np.asarray(correction.S, float).reshape(-1, order="F"), np.asarray(correction.o, float)])[:, None]
+                W[start + k:, correction_columns] = np.concatenate(
+                    [np.asarray(correction.S, float).reshape(-1, order="F"), np.asarray(correction.o, float)])
         if progress is not None:
             progress((start + k) / N)
-    outputs[N] = np.asarray(loop.discrete(z, W[:, N])[2]).ravel()
+    outputs[N] = np.asarray(loop.discrete(z, W[N])[2]).ravel()
     wall = time.perf_counter() - started
     signals = {name: Signal(outputs[:, sl].copy(), labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
-    return SimResult(W[0].copy(), signals, {}), timing
+    return SimResult(W[:, 0].copy(), signals, {}), timing
 
 
 def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled: bool):
-    """(advance(z, W_chunk) -> (z_end, outputs (k, n_out)), seconds spent building)."""
+    """(advance(z, W_rows, out_rows) -> z_end, seconds spent building); advance fills out_rows (k, n_out)."""
     started = time.perf_counter()
     if method == "fast":
-        rollers = {chunk: loop.step.mapaccum("roll", chunk)}
         if compiled and find_compiler() is not None:
             try:
-                rollers[chunk] = compile_function(rollers[chunk])
+                return compile_roll(loop.step), time.perf_counter() - started
             except CodegenError as exc:
                 warnings.warn(f"running the fast path interpreted: {exc}", stacklevel=3)
+        rollers = {}
+        states = np.empty((chunk, loop.n_z))
 
-        n_out = loop.step.size1_out("out")
-
-        def advance(z, W_chunk):
-            k = W_chunk.shape[1]
+        def advance(z, W_rows, out_rows):
+            k = W_rows.shape[0]
             if k not in rollers:
-                rollers[k] = loop.step.mapaccum("roll", k)
-            # buffer() evaluates without converting arguments; CasADi is column-major, so a
-            # C-ordered (k, n) array is the (n, k) matrix it expects.
+                rollers[k] = loop.step.mapaccum("closed_loop_roll", k)
+            # buffer() evaluates in place, without converting arguments; CasADi is column-major,
+            # so a C-ordered (k, n) array is the (n, k) matrix it expects.
             buffer, trigger = rollers[k].buffer()
-            z_in, w_in = np.ascontiguousarray(z, dtype=float), np.ascontiguousarray(W_chunk.T, dtype=float)
-            Z, out = np.empty((k, loop.n_z)), np.empty((k, n_out))
+            z_in = np.ascontiguousarray(z, dtype=float)
             buffer.set_arg(0, memoryview(z_in))
-            buffer.set_arg(1, memoryview(w_in))
-            buffer.set_res(0, memoryview(Z))
-            buffer.set_res(1, memoryview(out))
+            buffer.set_arg(1, memoryview(W_rows))
+            buffer.set_res(0, memoryview(states[:k]))
+            buffer.set_res(1, memoryview(out_rows))
             trigger()
-            return Z[-1].copy(), out
+            return states[k - 1].copy()
 
         return advance, time.perf_counter() - started
 
@@ -124,22 +127,19 @@ def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled:
                               f"{str(exc).splitlines()[-1]}") from None
     discrete = loop.discrete
     n = 2 * loop.model.dof
-    env_rows = slice(1 + n, 3 + n)
+    env_columns = slice(1 + n, 3 + n)
 
-    def advance(z, W_chunk):
-        k = W_chunk.shape[1]
-        out = np.empty((k, discrete.size1_out("out")))
-        for i in range(k):
-            w = W_chunk[:, i]
+    def advance(z, W_rows, out_rows):
+        for i, w in enumerate(W_rows):
             z_disc, u_cmd, out_i = discrete(z, w)
-            p_i = np.concatenate([np.asarray(u_cmd).ravel(), w[env_rows], w[:1]])
+            p_i = np.concatenate([np.asarray(u_cmd).ravel(), w[env_columns], w[:1]])
             try:
                 s_next = integrator(x0=z[:n_s], p=p_i)["xf"]
             except RuntimeError as exc:
                 raise SimulationError(f"{method} failed at t = {w[0]:.6g} s: {str(exc).splitlines()[-1]}") from None
             z = np.concatenate([np.asarray(s_next).ravel(), np.asarray(z_disc).ravel()])
-            out[i] = np.asarray(out_i).ravel()
-        return z, out
+            out_rows[i] = np.asarray(out_i).ravel()
+        return z
 
     return advance, time.perf_counter() - started
 

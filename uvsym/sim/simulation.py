@@ -54,16 +54,16 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     dof, m, n = model.dof, model.n_inputs, 2 * model.dof
     x0 = np.concatenate([_vector(eta0, dof, "eta0"), _vector(nu0, dof, "nu0")])
     rng = np.random.default_rng(seed)
-    W = np.empty((loop.n_w, N + 1))
-    W[0] = dt * np.arange(N + 1)
-    W[1:1 + n] = rng.standard_normal((n, N + 1))
-    W[1 + n:3 + n] = env.reshape(-1, 2).T
-    W[3 + n:] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])[:, None]
+    W = np.empty((N + 1, loop.n_w))  # one row per sample: [t, noise, V_c, beta_c, vec(S), o]
+    W[:, 0] = dt * np.arange(N + 1)
+    W[:, 1:1 + n] = rng.standard_normal((N + 1, n))
+    W[:, 1 + n:3 + n] = env.reshape(-1, 2)
+    W[:, 3 + n:] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
 
     lay = loop.layout
     z0 = np.zeros(loop.n_z)
     z0[lay["x"]], z0[lay["held"]] = x0, x0
-    _, u_cmd0, _ = loop.discrete(z0, W[:, 0])
+    _, u_cmd0, _ = loop.discrete(z0, W[0])
     a0 = np.asarray(u_cmd0).ravel() if actuators0 is None else _vector(actuators0, m, "actuators0")
     z0[lay["a"]], z0[lay["a_expected"]] = a0, a0
     tau_d0 = np.asarray(model.tau(x0[:dof], x0[dof:], a0, 0.0, 0.0)).ravel()
