@@ -188,6 +188,7 @@ def _scenario_data():
     (lambda d: d["observers"][0].pop("tau_d"), "observers[0].tau_d"),
     (lambda d: d["observers"][1].update(kind="sliding"), "observers[1].kind"),
     (lambda d: d["current"].update(speed=math.nan), "current.speed"),
+    (lambda d: d["current"].update(time_constant=0.0), "current.time_constant"),
 ])
 def test_bad_scenario_names_the_field(edit, field):
     data = _scenario_data()
@@ -224,3 +225,28 @@ def test_the_compiled_fast_path_leaves_the_floating_point_state_alone(docking):
     simulate_scenario(_short(docking, 0.5), compiled=True)
     tiny = sys.float_info.min / 4  # subnormal: flushed to zero if a library switched on FTZ/DAZ
     assert tiny > 0.0 and tiny * 2 > tiny
+
+
+def test_fault_signals_show_what_each_fault_does(docking):
+    _, faulty = _healthy_and_faulty(docking, actuator_faults=docking.actuator_faults,
+                                    sensor_faults=(SensorFault(2, "bias", 0.5, Profile("step", onset=1.0)),))
+    np.testing.assert_allclose(faulty["fault_actuator"]["X"], 13.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(faulty["fault_actuator"]["delta_ru"], -0.2 * faulty["u_expected"]["delta_ru"],
+                               rtol=1e-12, atol=1e-15)
+    t = faulty.t
+    np.testing.assert_array_equal(faulty["fault_sensor"]["z"][t < 1.0 - 1e-12], 0.0)
+    np.testing.assert_allclose(faulty["fault_sensor"]["z"][t >= 1.0 - 1e-12], 0.5, atol=1e-12)
+
+
+def test_current_variation_is_seeded_and_has_the_requested_spread(docking):
+    from dataclasses import replace
+
+    from uvsym.sim.simulation import current_profile
+
+    varied = replace(docking, current=(0.5, 0.3), current_variation=(0.1, 5.0), duration=2000.0, step=0.1)
+    profile = current_profile(varied)
+    np.testing.assert_array_equal(profile, current_profile(varied))  # same seed, same draws
+    assert not np.array_equal(profile, current_profile(replace(varied, seed=varied.seed + 5)))
+    assert profile.shape == (20001, 2) and np.all(profile[:, 1] == 0.3)
+    assert abs(np.std(profile[:, 0]) - 0.1) < 0.02 and abs(np.mean(profile[:, 0]) - 0.5) < 0.03
+    assert current_profile(docking) == docking.current  # no variation: a constant pair

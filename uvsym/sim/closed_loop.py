@@ -132,13 +132,16 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
         start += size
 
     a_now = z[layout["a"]]
+    u_actual = apply_actuator_faults(a_now, t, actuator_faults)
     out_parts = {
         "x": (x, model.state_labels, model.state_units),
         "y": (y, model.state_labels, model.state_units),
         "u_desired": (u_d, model.input_labels, model.input_units),
         "u_command": (u_cmd, model.input_labels, model.input_units),
         "u_expected": (a_expected, model.input_labels, model.input_units),
-        "u_actual": (apply_actuator_faults(a_now, t, actuator_faults), model.input_labels, model.input_units),
+        "u_actual": (u_actual, model.input_labels, model.input_units),
+        "fault_actuator": (u_actual - a_now, model.input_labels, model.input_units),
+        "fault_sensor": (y - x, model.state_labels, model.state_units),
         "tau_desired": (tau_d, FORCE_LABELS[model.dof], model.force_units),
         "reference": (refs, controller.reference_labels, controller.reference_units),
     }

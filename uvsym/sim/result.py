@@ -39,8 +39,9 @@ class Signal:
 
 @dataclass(frozen=True)
 class SimResult:
-    """t: (N,) s; signals: name -> Signal (x, y, u_desired, u_command, u_actual, tau_desired,
-    reference, f_hat/<observer>, ...); meta: JSON-friendly description of the run."""
+    """t: (N,) s; signals: name -> Signal (x, y, u_desired, u_command, u_expected, u_actual,
+    fault_actuator, fault_sensor, tau_desired, reference, f_hat/<observer>; see ``simulate``);
+    meta: JSON-friendly description of the run."""
 
     t: np.ndarray
     signals: dict[str, Signal]

@@ -39,7 +39,11 @@ class ObserverSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario (see the module docstring); ``model`` is built with the overrides."""
+    """A validated scenario (see the module docstring); ``model`` is built with the overrides.
+
+    current: mean (V_c m/s, beta_c rad); current_variation: (standard deviation m/s, time
+    constant s) of a first-order Gauss-Markov variation of the speed, drawn from ``seed``.
+    """
 
     name: str
     description: str
@@ -55,6 +59,7 @@ class Scenario:
     actuator_faults: tuple[ActuatorFault, ...]
     sensor_faults: tuple[SensorFault, ...]
     observers: tuple[ObserverSpec, ...]
+    current_variation: tuple[float, float] = (0.0, 10.0)
 
 
 class _Fields:
@@ -175,6 +180,7 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
     current = top.table("current") or _Fields({}, "current")
     V_c = current.number("speed", 0.0, minimum=0.0)
     beta_c = math.radians(current.number("direction_deg", 0.0))
+    variation = (current.number("speed_std", 0.0, minimum=0.0), current.number("time_constant", 10.0, positive=True))
     current.done()
 
     controller = _controller(top.table("controller"), model)
@@ -182,7 +188,8 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
     observers = tuple(_observer(f, dof) for f in top.tables("observers"))
     top.done()
     return Scenario(name=name, description=description, model=model, duration=duration, step=step, seed=seed,
-                    eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c), controller=controller,
+                    eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c),
+                    current_variation=variation, controller=controller,
                     actuator_faults=actuator_faults, sensor_faults=sensor_faults, observers=observers)
 
 

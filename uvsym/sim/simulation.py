@@ -16,7 +16,7 @@ from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, grid, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
 
-__all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers"]
+__all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers", "current_profile"]
 
 
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
@@ -40,7 +40,9 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
 
     Returns
     -------
-    SimResult with signals x, y, u_desired, u_command, u_actual, tau_desired, reference and
+    SimResult with signals x (true state), y (measured), u_desired (controller), u_command (sent,
+    corrected and saturated), u_expected (what healthy actuators deliver), u_actual (delivered),
+    fault_actuator (u_actual - healthy), fault_sensor (y - x), tau_desired, reference and
     f_hat/<observer>, one row per grid time ``0, dt, ..., duration``.
     """
     N = grid(duration, dt)
@@ -105,6 +107,25 @@ def scenario_observers(model: Model, specs: tuple[ObserverSpec, ...]) -> dict[st
     return observers
 
 
+def current_profile(scenario: Scenario):
+    """(V_c, beta_c), or with a speed variation one row per sample (N + 1, 2): a first-order
+    Gauss-Markov process ``V' = -(V - V_mean) / T + w`` of the given standard deviation, seeded
+    with ``scenario.seed + 1`` (independent of the sensor-noise draws), speed kept >= 0."""
+    std, T = scenario.current_variation
+    if std == 0.0:
+        return scenario.current
+    N = grid(scenario.duration, scenario.step)
+    a = np.exp(-scenario.step / T)
+    rng = np.random.default_rng(scenario.seed + 1)
+    deviation = np.empty(N + 1)
+    deviation[0] = std * rng.standard_normal()
+    kicks = std * np.sqrt(1 - a * a) * rng.standard_normal(N)
+    for k in range(N):
+        deviation[k + 1] = a * deviation[k] + kicks[k]
+    speed = np.maximum(scenario.current[0] + deviation, 0.0)
+    return np.column_stack([speed, np.full(N + 1, scenario.current[1])])
+
+
 def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...]) -> tuple[ObserverBlock, ...]:
     """The scenario's observers as blocks of the closed loop, named by their kind."""
     return tuple(ObserverBlock(kind, observer.function, K, FORCE_LABELS[model.dof],
@@ -117,7 +138,7 @@ def simulate_scenario(scenario: Scenario, *, method: str = "fast", supervisor: S
     """Run a validated :class:`Scenario`; keyword options go to :func:`simulate` (e.g. substeps)."""
     result = simulate(scenario.model, scenario.controller, duration=scenario.duration, dt=scenario.step,
                       eta0=scenario.eta0, nu0=scenario.nu0, actuators0=scenario.actuators0,
-                      current=scenario.current, actuator_faults=scenario.actuator_faults,
+                      current=current_profile(scenario), actuator_faults=scenario.actuator_faults,
                       sensor_faults=scenario.sensor_faults,
                       observers=observer_blocks(scenario.model, scenario.observers),
                       supervisor=supervisor, method=method, seed=scenario.seed, progress=progress, **options)
