@@ -113,6 +113,18 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+def _cmd_codegen(args) -> int:
+    from uvsym.codegen.observer_sets import observer_set
+    from uvsym.codegen.package import write_package
+
+    name, description, functions = observer_set(args.name, vehicle_name=args.vehicle, form=args.form)
+    manifest = write_package(args.out, functions, name, "float" if args.float else "double", description)
+    print(f"wrote {args.out}: {name}, {len(manifest['functions'])} functions "
+          f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
+          f"build with 'make' or cmake")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
@@ -137,6 +149,16 @@ def _parser() -> argparse.ArgumentParser:
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
     simulate.set_defaults(run=_cmd_simulate)
+    from uvsym.codegen.observer_sets import OBSERVER_SETS
+    from uvsym.observers import FORMS
+
+    codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest)")
+    codegen.add_argument("name", help=f"observer set: {', '.join(OBSERVER_SETS)}")
+    codegen.add_argument("-o", "--out", required=True, help="output folder")
+    codegen.add_argument("--vehicle", default="remus100", help="vehicle of the library (default remus100)")
+    codegen.add_argument("--form", choices=FORMS, default="momentum", help="observer form (default momentum)")
+    codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi)")
+    codegen.set_defaults(run=_cmd_codegen)
     return parser
 
 

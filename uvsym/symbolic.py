@@ -9,7 +9,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-__all__ = ["is_casadi", "stack", "block", "matvec", "entries"]
+__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4"]
 
 _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
@@ -56,3 +56,16 @@ def entries(vector, n: int, name: str = "vector"):
     if array.size != n:
         raise ValueError(f"{name} must have {n} entries, got {array.size}")
     return list(array)
+
+
+def rk4(ode, s, h: float, steps: int, *args, t=0.0):
+    """``steps`` classical RK4 steps of ``s' = ode(s, *args, t)`` over ``h`` seconds (symbolic)."""
+    dh = h / steps
+    for i in range(steps):
+        ti = t + i * dh
+        k1 = ode(s, *args, ti)
+        k2 = ode(s + dh / 2 * k1, *args, ti + dh / 2)
+        k3 = ode(s + dh / 2 * k2, *args, ti + dh / 2)
+        k4 = ode(s + dh * k3, *args, ti + dh)
+        s = s + dh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return s

@@ -27,8 +27,9 @@ from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
 from uvsym.observers.discrete import SampledObserver, sampled_observer
 from uvsym.sim.controllers import Autopilot
+from uvsym.symbolic import rk4
 
-__all__ = ["ObserverBlock", "ClosedLoop", "build_closed_loop", "rk4"]
+__all__ = ["ObserverBlock", "ClosedLoop", "build_closed_loop"]
 
 
 @dataclass(frozen=True)
@@ -70,19 +71,6 @@ class ClosedLoop:
     observer_slices: dict
     sampled: dict[str, SampledObserver]
     signals: dict  # name -> (slice of out, labels, units)
-
-
-def rk4(ode, s, h: float, steps: int, *args, t=0.0):
-    """``steps`` classical RK4 steps of ``s' = ode(s, *args, t)`` over ``h`` seconds (symbolic)."""
-    dh = h / steps
-    for i in range(steps):
-        ti = t + i * dh
-        k1 = ode(s, *args, ti)
-        k2 = ode(s + dh / 2 * k1, *args, ti + dh / 2)
-        k3 = ode(s + dh / 2 * k2, *args, ti + dh / 2)
-        k4 = ode(s + dh * k3, *args, ti + dh)
-        s = s + dh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return s
 
 
 def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,

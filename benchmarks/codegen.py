@@ -1,0 +1,94 @@
+"""Cost of one step of the three actuator observers of the REMUS 100, generated C versus Python.
+
+Run ``python benchmarks/codegen.py``; writes ``benchmarks/results/codegen.json``. ``step_ns``: the
+combined step (proportional, bias and constant observers, one RK4 step each) of the generated
+package, timed in a C loop (best of five batches); beside it the same Function called from
+Python. Compare as ratios within one run: the machine is shared.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+from uvsym.codegen import find_compiler
+from uvsym.codegen.observer_sets import observer_set
+from uvsym.codegen.package import write_package
+
+RESULTS = Path(__file__).resolve().parent / "results" / "codegen.json"
+
+TIMING = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <time.h>
+#include "%(name)s.h"
+int main(void) {
+  static uvsym_real x[18], eta[6] = {0, 0, 5, 0.01, 0.02, 0.3}, nu[6] = {1.5, 0.1, 0.02, 0.01, 0.01, 0.02};
+  static uvsym_real tau[6] = {10, 1, 2, 0.1, 1, 0.5}, K[18], dt[1] = {0.01}, x_next[18], f_hat[18];
+  const long n = 1000000;
+  double best = 1e30, sink = 0.0;
+  int i, rep;
+  for (i = 0; i < 18; ++i) K[i] = 1.0;
+  for (rep = 0; rep < 5; ++rep) {
+    struct timespec t0, t1;
+    long k;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (k = 0; k < n; ++k) {
+      nu[0] = 1.5 + 1e-9 * (double)(k & 1023);
+      uvsym_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat);
+      sink += f_hat[0];
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double ns = ((t1.tv_sec - t0.tv_sec) * 1e9 + (t1.tv_nsec - t0.tv_nsec)) / (double)n;
+    if (ns < best) best = ns;
+  }
+  printf("%%.3f %%.17g\n", best, sink);
+  return 0;
+}
+"""
+
+
+def main() -> dict:
+    name, description, functions = observer_set("actuator-observers", vehicle_name="remus100", form="momentum")
+    combined = functions[-1].function
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch)
+        write_package(folder, functions, name, "double", description)
+        (folder / "timing.c").write_text(TIMING % {"name": name})
+        exe = folder / "timing"
+        subprocess.run([find_compiler(), "-std=c99", "-O3", "-march=native", "-I", str(folder / "include"),
+                        str(folder / "src" / f"{name}_casadi.c"), str(folder / "src" / f"{name}.c"),
+                        str(folder / "timing.c"), "-o", str(exe), "-lm"], check=True)
+        step_ns = float(subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split()[0])
+    args = [np.zeros(18), np.array([0, 0, 5, 0.01, 0.02, 0.3]), np.array([1.5, 0.1, 0.02, 0.01, 0.01, 0.02]),
+            np.array([10, 1, 2, 0.1, 1, 0.5]), np.ones(18), np.array([0.01])]
+    dm_args = [ca.DM(a) for a in args]
+    best = float("inf")
+    for _ in range(5):
+        started = time.perf_counter()
+        for _ in range(2000):
+            combined(*dm_args)
+        best = min(best, (time.perf_counter() - started) / 2000)
+    return {"function": combined.name(), "vehicle": "remus100", "form": "momentum",
+            "sx_instructions": combined.n_instructions(), "step_ns": step_ns,
+            "python_dm_args_us_per_call": best * 1e6, "speedup_c_over_python": best * 1e9 / step_ns,
+            "targets": {"step_ns_max": 300},
+            "machine": {"python": platform.python_version(), "casadi": ca.__version__,
+                        "processor": platform.machine()}}
+
+
+if __name__ == "__main__":
+    if find_compiler() is None:
+        sys.exit("no C compiler: nothing to measure")
+    results = main()
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
+    print(json.dumps(results, indent=2))

@@ -1,0 +1,158 @@
+"""The C package of the actuator observers: builds, runs clean under sanitizers, matches Python."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from uvsym.codegen import find_compiler
+from uvsym.codegen.observer_sets import observer_set
+from uvsym.codegen.package import write_package
+from uvsym.errors import CodegenError
+
+pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler (set $CC or install gcc)")
+
+STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+FLOAT_RTOL = 1e-5  # single precision: bound on max |c - python| / max(1, max |python|) per call (normwise)
+
+
+@pytest.fixture(scope="module")
+def observers():
+    return observer_set("actuator-observers", vehicle_name="remus100", form="momentum")
+
+
+@pytest.fixture(scope="module")
+def package(tmp_path_factory, observers):
+    name, description, functions = observers
+    out = tmp_path_factory.mktemp("pkg")
+    write_package(out, functions, name, "double", description)
+    return out, name, functions
+
+
+def _build_harness(package_dir: Path, name: str, extra: list[str]) -> Path:
+    exe = package_dir / f"harness_{abs(hash(tuple(extra)))}"
+    sources = [str(package_dir / "src" / f"{name}_casadi.c"), str(package_dir / "src" / f"{name}.c"),
+               str(package_dir / "harness.c")]
+    subprocess.run([find_compiler(), *STRICT, *extra, "-I", str(package_dir / "include"), *sources, "-o", str(exe),
+                    "-lm"], check=True, capture_output=True, text=True)
+    return exe
+
+
+def _inputs(functions, rng, special: bool):
+    """Records (index, [input arrays]) for every function: random, and NaN/Inf/huge when special."""
+    records = []
+    for index, e in enumerate(functions):
+        f = e.function
+        for _ in range(25):
+            args = [rng.normal(scale=[3.0, 0.5, 2.0, 50.0, 1.0, 0.05][min(i, 5)], size=f.nnz_in(i))
+                    for i in range(f.n_in())]
+            args[-1] = np.abs(args[-1]) + 0.01 if f.name_in(f.n_in() - 1) == "dt" else np.abs(args[-1]) + 0.1
+            if special and rng.random() < 0.5:
+                which = rng.integers(f.n_in())
+                args[which] = args[which].copy()
+                args[which][rng.integers(args[which].size)] = rng.choice([np.nan, np.inf, -np.inf, 1e300, -1e300])
+            records.append((index, args))
+    return records
+
+
+def _run(exe: Path, records) -> tuple[list[np.ndarray], str]:
+    text = "\n".join(f"{i} " + " ".join(repr(float(v)) for a in args for v in a) for i, args in records) + "\n"
+    done = subprocess.run([str(exe)], input=text, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    rows = [np.array([float(v) for v in line.split()]) for line in done.stdout.strip().splitlines()]
+    return rows, done.stderr
+
+
+def _python(functions, records):
+    rows = []
+    for index, args in records:
+        with np.errstate(all="ignore"):
+            result = functions[index].function(*args)
+        rows.append(np.concatenate([np.asarray(r, dtype=float).ravel(order="F") for r in result]))
+    return rows
+
+
+def test_same_inputs_give_byte_identical_packages(tmp_path, observers):
+    name, description, functions = observers
+    write_package(tmp_path / "a", functions, name, "double", description)
+    again = observer_set("actuator-observers", vehicle_name="remus100", form="momentum")  # derived anew
+    write_package(tmp_path / "b", again[2], again[0], "double", again[1])
+    files = sorted(p.relative_to(tmp_path / "a") for p in (tmp_path / "a").rglob("*") if p.is_file())
+    assert len(files) == 9
+    for relative in files:
+        assert (tmp_path / "a" / relative).read_bytes() == (tmp_path / "b" / relative).read_bytes(), relative
+
+
+def test_make_builds_libraries_and_example_with_strict_cflags(tmp_path, package):
+    source, name, _ = package
+    work = tmp_path / "build"
+    shutil.copytree(source, work)
+    done = subprocess.run(["make", "CFLAGS=-std=c99 -O2 -Wall -Wextra -Werror -fPIC"], cwd=work,
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    for artefact in (f"lib{name}.a", f"lib{name}.so", "example", "harness"):
+        assert (work / artefact).exists(), artefact
+    assert subprocess.run([str(work / "example")], capture_output=True, text=True).returncode == 0
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="cmake not installed")
+def test_cmake_builds_from_an_empty_directory(tmp_path, package):
+    source, _, _ = package
+    build = tmp_path / "cmake-build"
+    build.mkdir()
+    for command in (["cmake", "-S", str(source), "-B", str(build)], ["cmake", "--build", str(build)]):
+        done = subprocess.run(command, capture_output=True, text=True)
+        assert done.returncode == 0, done.stdout + done.stderr
+    assert subprocess.run([str(build / "example")], capture_output=True).returncode == 0
+
+
+def test_c_matches_python_under_sanitizers_including_nan_inf_and_huge(package):
+    source, name, functions = package
+    exe = _build_harness(source, name, ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"])
+    records = _inputs(functions, np.random.default_rng(7), special=True)
+    c_rows, stderr = _run(exe, records)
+    assert "runtime error" not in stderr and "AddressSanitizer" not in stderr
+    python_rows = _python(functions, records)
+    assert len(c_rows) == len(python_rows)
+    for (index, _), c, py in zip(records, c_rows, python_rows):
+        scale = np.maximum(1.0, np.abs(np.where(np.isfinite(py), py, 0.0)))
+        with np.errstate(invalid="ignore"):
+            close = np.abs(c - py) <= 1e-12 * scale
+        same_special = (np.isnan(c) & np.isnan(py)) | (np.isinf(c) & (c == py))
+        assert np.all(close | same_special), functions[index].function.name()
+
+
+def test_float_build_matches_python_within_its_bound(tmp_path, observers):
+    name, description, functions = observers
+    write_package(tmp_path, functions, name, "float", description)
+    exe = _build_harness(tmp_path, name, ["-O2"])
+    records = _inputs(functions, np.random.default_rng(3), special=False)
+    c_rows, _ = _run(exe, records)
+    for c, py in zip(c_rows, _python(functions, records)):
+        assert np.max(np.abs(c - py)) <= FLOAT_RTOL * max(1.0, float(np.max(np.abs(py))))
+
+
+def test_the_double_library_loads_through_casadi_external(tmp_path, package):
+    source, name, functions = package
+    work = tmp_path / "build"
+    shutil.copytree(source, work)
+    subprocess.run(["make", f"lib{name}.so"], cwd=work, check=True, capture_output=True)
+    combined = functions[-1].function
+    loaded = ca.external(combined.name(), str(work / f"lib{name}.so"))
+    rng = np.random.default_rng(0)
+    args = [rng.normal(size=combined.nnz_in(i)) for i in range(combined.n_in())]
+    for ours, theirs in zip(loaded(*args), combined(*args)):
+        np.testing.assert_allclose(np.asarray(ours), np.asarray(theirs), rtol=1e-13, atol=1e-15)
+
+
+def test_unknown_precision_and_bad_names_are_refused(tmp_path, observers):
+    name, _, functions = observers
+    with pytest.raises(CodegenError, match="unknown precision"):
+        write_package(tmp_path, functions, name, "half")
+    with pytest.raises(CodegenError, match="C identifier"):
+        write_package(tmp_path, functions, "my-observers")
