@@ -156,3 +156,11 @@ def test_unknown_precision_and_bad_names_are_refused(tmp_path, observers):
         write_package(tmp_path, functions, name, "half")
     with pytest.raises(CodegenError, match="C identifier"):
         write_package(tmp_path, functions, "my-observers")
+
+
+def test_generated_sources_allocate_nothing(package):
+    source, _, _ = package
+    code = "".join(p.read_text() for p in [*source.glob("src/*.c"), *source.glob("include/*.h"), source / "main.c"])
+    for call in ("malloc(", "calloc(", "realloc(", "free("):
+        assert call not in code, call
+    assert "static casadi_real w[" in code  # work buffers are static
