@@ -285,3 +285,16 @@ def test_diagnosis_in_the_loop_identifies_the_docking_faults():
         assert abs(diagnosis.identified[rudder].value - 0.8) < 0.001
     assert list(diagnosis.healthy) == ["delta_e"]
     assert diagnosis.isolation_time_s < 5.0
+
+
+@pytest.mark.parametrize("builder", ["proportional_observer", "bias_observer", "constant_observer"])
+def test_observer_functions_have_the_named_signature_and_an_init(builder):
+    import uvsym.observers as observers
+
+    model = vehicle(OTTER)
+    function = getattr(observers, builder)(model)
+    assert function.name_in() == ["x", "eta", "nu", "tau_d", "K"]
+    assert function.name_out() == ["x_dot", "f_hat"]
+    eta, nu, tau_d, K = np.array([1.0, 2.0, 0.3]), np.array([1.2, 0.1, 0.05]), np.array([40.0, 3.0, 8.0]), np.ones(3)
+    x0 = observers.init_state(function, eta, nu, tau_d, K)
+    np.testing.assert_allclose(np.asarray(function(x0, eta, nu, tau_d, K)[1]).ravel(), 0.0, atol=1e-12)
