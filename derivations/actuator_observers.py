@@ -19,6 +19,7 @@ import numpy as np
 from uvsym.observers.isolation import IsolationSettings
 from uvsym.observers.supervisor import FaultDiagnosis
 from uvsym.report import markdown_table, save_svg, write_json
+from uvsym.report.sympy_bridge import latex
 from uvsym.sim.scenario import Scenario, load_scenario
 from uvsym.sim.simulation import scenario_observers, simulate_scenario
 
@@ -265,6 +266,19 @@ def build(out_dir: Path, progress) -> None:
     (out_dir / "report.md").write_text(_report(scenario, results, checks))
 
 
+def _derived_gains(scenario: Scenario) -> str:
+    """LaTeX of L = dR/dnu of each observer in the loop, as CasADi derives it."""
+    n = scenario.model.dof
+    nu, tau_d, K = ca.SX.sym("nu", n), ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
+    parts = []
+    for kind, (observer, _) in scenario_observers(scenario.model, scenario.observers).items():
+        R = latex(observer.R(nu, tau_d, K)[0], 4)
+        parts.append(f"- {kind} ({observer.form} form), first entry of R: $R_1 = {R}$; "
+                     f"$L = \\partial R / \\partial \\nu$:\n\n$$L_{{{kind[0]}}} = "
+                     f"{latex(observer.L(nu, tau_d, K), 4)}$$")
+    return "\n\n".join(parts)
+
+
 def _report(scenario: Scenario, r: dict, checks: dict) -> str:
     rows = [
         ["isolation time (s)", _fmt(r["isolation_time_s"], 4), _fmt(PAPER["isolation_time_s"]),
@@ -340,6 +354,12 @@ loop. Every number below is computed by `uvsym report actuator-observers`.
   1 s window; `f_bar` comes from a least-squares fit of the paper's eq. 19 (the closed form behind
   eqs. 22-24). Identification: `u = u_e + B^+ (tau_hat - tau_d)` on the decided channels.
   Correction: `u* = u_d / f_bar_p` for the rudders, `u* = u_d - f_bar_a` for the thruster.
+
+## Derived by CasADi (not typed)
+
+The numbers are entries of M (kg, kg m, kg m^2), shown to 4 digits (the code keeps every bit); $k_i$ are the gains, $\\tau_{{d,i}}$ the desired forces:
+
+{_derived_gains(scenario)}
 
 ## Isolation per channel (run with correction)
 
