@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -19,41 +18,15 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from c_timing import c_loop_ns  # noqa: E402
+
 from uvsym.codegen import find_compiler
 from uvsym.codegen.observer_sets import observer_set
 from uvsym.codegen.package import write_package
 
 RESULTS = Path(__file__).resolve().parent / "results" / "codegen.json"
-
-TIMING = r"""
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <time.h>
-#include "%(name)s.h"
-int main(void) {
-  static uvsym_real x[18], eta[6] = {0, 0, 5, 0.01, 0.02, 0.3}, nu[6] = {1.5, 0.1, 0.02, 0.01, 0.01, 0.02};
-  static uvsym_real tau[6] = {10, 1, 2, 0.1, 1, 0.5}, K[18], dt[1] = {0.01}, x_next[18], f_hat[18];
-  const long n = 1000000;
-  double best = 1e30, sink = 0.0;
-  int i, rep;
-  for (i = 0; i < 18; ++i) K[i] = 1.0;
-  for (rep = 0; rep < 5; ++rep) {
-    struct timespec t0, t1;
-    long k;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (k = 0; k < n; ++k) {
-      nu[0] = 1.5 + 1e-9 * (double)(k & 1023);
-      uvsym_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat);
-      sink += f_hat[0];
-    }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    double ns = ((t1.tv_sec - t0.tv_sec) * 1e9 + (t1.tv_nsec - t0.tv_nsec)) / (double)n;
-    if (ns < best) best = ns;
-  }
-  printf("%%.3f %%.17g\n", best, sink);
-  return 0;
-}
-"""
 
 
 def main() -> dict:
@@ -62,12 +35,14 @@ def main() -> dict:
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         write_package(folder, functions, name, "double", description)
-        (folder / "timing.c").write_text(TIMING % {"name": name})
-        exe = folder / "timing"
-        subprocess.run([find_compiler(), "-std=c99", "-O3", "-march=native", "-I", str(folder / "include"),
-                        str(folder / "src" / f"{name}_casadi.c"), str(folder / "src" / f"{name}.c"),
-                        str(folder / "timing.c"), "-o", str(exe), "-lm"], check=True)
-        step_ns = float(subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split()[0])
+        setup = """
+  static uvsym_real x[18], eta[6] = {0, 0, 5, 0.01, 0.02, 0.3}, nu[6] = {1.5, 0.1, 0.02, 0.01, 0.01, 0.02};
+  static uvsym_real tau[6] = {10, 1, 2, 0.1, 1, 0.5}, K[18], dt[1] = {0.01}, x_next[18], f_hat[18];
+  int k;
+  for (k = 0; k < 18; ++k) K[k] = 1.0;"""
+        step_ns = c_loop_ns([folder / "src" / f"{name}_casadi.c", folder / "src" / f"{name}.c"], folder / "include",
+                            f"{name}.h", setup, "uvsym_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat)",
+                            "nu[0]", 1.5, "f_hat[0]")
     args = [np.zeros(18), np.array([0, 0, 5, 0.01, 0.02, 0.3]), np.array([1.5, 0.1, 0.02, 0.01, 0.01, 0.02]),
             np.array([10, 1, 2, 0.1, 1, 0.5]), np.ones(18), np.array([0.01])]
     dm_args = [ca.DM(a) for a in args]

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import json
 import platform
-import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -19,6 +17,7 @@ import casadi as ca
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from c_timing import c_loop_ns  # noqa: E402
 from remus100_numpy import Remus100Numpy  # noqa: E402
 
 import uvsym  # noqa: E402
@@ -27,38 +26,6 @@ RESULTS = Path(__file__).resolve().parent / "results" / "rhs.json"
 ETA = np.array([10.0, -5.0, 20.0, 0.1, -0.05, 0.7])
 NU = np.array([1.5, 0.1, -0.05, 0.02, -0.03, 0.04])
 U = np.array([0.1, -0.05, 1200.0])
-
-C_LOOP = r"""
-#include <stdio.h>
-#include <time.h>
-#include "nu_dot.h"
-int main(void) {
-  static casadi_real eta[6] = {10.0, -5.0, 20.0, 0.1, -0.05, 0.7};
-  static casadi_real nu[6] = {1.5, 0.1, -0.05, 0.02, -0.03, 0.04};
-  static casadi_real u[3] = {0.1, -0.05, 1200.0};
-  static casadi_real V_c = 0.0, beta_c = 0.0, out[6], w[nu_dot_SZ_W];
-  static casadi_int iw[nu_dot_SZ_IW];
-  const casadi_real *arg[nu_dot_SZ_ARG] = {eta, nu, u, &V_c, &beta_c};
-  casadi_real *res[nu_dot_SZ_RES] = {out};
-  const long n = 2000000;
-  double best = 1e30, sink = 0.0;
-  for (int rep = 0; rep < 5; ++rep) {
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (long i = 0; i < n; ++i) {
-      nu[0] = 1.5 + 1e-9 * (double)(i & 1023);   /* defeat hoisting */
-      nu_dot(arg, res, iw, w, 0);
-      sink += out[0];
-    }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    double ns = ((t1.tv_sec - t0.tv_sec) * 1e9 + (t1.tv_nsec - t0.tv_nsec)) / (double)n;
-    if (ns < best) best = ns;
-  }
-  printf("%.3f %.17g\n", best, sink);
-  return 0;
-}
-"""
-
 
 def median_time(call, repeat: int = 7, number: int = 2000) -> float:
     """Median seconds per call over ``repeat`` batches of ``number`` calls."""
@@ -71,21 +38,22 @@ def median_time(call, repeat: int = 7, number: int = 2000) -> float:
     return float(np.median(times))
 
 
-def c_loop_ns(function: ca.Function) -> float | None:
-    """ns per call of the generated C of ``function`` timed in a C loop (None without gcc)."""
-    compiler = shutil.which("gcc") or shutil.which("cc")
-    if compiler is None:
-        return None
+def nu_dot_c_ns(function: ca.Function) -> float | None:
+    """ns per call of the generated C of ``function`` (nu_dot) timed in a C loop (None without gcc)."""
     with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
         generator = ca.CodeGenerator("nu_dot", {"with_header": True})
         generator.add(function)
         generator.generate(str(tmp) + "/")
-        (tmp / "main.c").write_text(C_LOOP)
-        subprocess.run([compiler, "-O3", "-o", str(tmp / "bench"), str(tmp / "main.c"), str(tmp / "nu_dot.c"), "-lm"],
-                       check=True, cwd=tmp)
-        out = subprocess.run([str(tmp / "bench")], capture_output=True, text=True, check=True).stdout
-    return float(out.split()[0])
+        setup = """
+  static casadi_real eta[6] = {10.0, -5.0, 20.0, 0.1, -0.05, 0.7};
+  static casadi_real nu[6] = {1.5, 0.1, -0.05, 0.02, -0.03, 0.04};
+  static casadi_real u[3] = {0.1, -0.05, 1200.0};
+  static casadi_real V_c = 0.0, beta_c = 0.0, out[6], w[nu_dot_SZ_W];
+  static casadi_int iw[nu_dot_SZ_IW];
+  const casadi_real *arg[nu_dot_SZ_ARG] = {eta, nu, u, &V_c, &beta_c};
+  casadi_real *res[nu_dot_SZ_RES] = {out};"""
+        return c_loop_ns([Path(tmp) / "nu_dot.c"], Path(tmp), "nu_dot.h", setup, "nu_dot(arg, res, iw, w, 0)",
+                         "nu[0]", 1.5, "out[0]", calls=2_000_000)
 
 
 def main() -> dict:
@@ -109,7 +77,7 @@ def main() -> dict:
     buffer_s = median_time(trigger, number=20000)
     np.testing.assert_allclose(output, expected, rtol=1e-14)
 
-    c_ns = c_loop_ns(f)
+    c_ns = nu_dot_c_ns(f)
     results = {
         "vehicle": "remus100",
         "function": "nu_dot(eta, nu, u, V_c, beta_c)",
