@@ -130,3 +130,14 @@ def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path):
     result = run("simulate", str(scenario))
     assert result.returncode == 2
     assert "faults[0]" in result.stderr and "wobble" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_codegen_writes_the_package_and_refuses_unknown_sets(tmp_path, capsys):
+    assert main(["codegen", "actuator-observers", "-o", str(tmp_path / "pkg"), "--vehicle", "otter3dof"]) == 0
+    assert "uvsym_bias_step" in capsys.readouterr().out
+    manifest = json.loads((tmp_path / "pkg" / "manifest.json").read_text())
+    assert manifest["precision"] == "double" and len(manifest["functions"]) == 7
+    for path in ("Makefile", "CMakeLists.txt", "main.c", "harness.c", "include/uvsym_otter3dof_observers.h"):
+        assert (tmp_path / "pkg" / path).exists(), path
+    result = run("codegen", "sliding-mode", "-o", str(tmp_path / "x"))
+    assert result.returncode == 2 and "unknown observer set" in result.stderr
