@@ -1,0 +1,7 @@
+"""Machine-checked claims: symbolic identities and Lyapunov/LMI certificates, as data."""
+
+from uvsym.verify.certificate import STATUSES, Certificate
+from uvsym.verify.identity import prove_identity
+from uvsym.verify.lyapunov import exact_positive_definite, lyapunov_decrease
+
+__all__ = ["STATUSES", "Certificate", "exact_positive_definite", "lyapunov_decrease", "prove_identity"]

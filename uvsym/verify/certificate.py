@@ -1,0 +1,45 @@
+"""Certificates: what was claimed, over which set, by which method, with which margin and outcome."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+__all__ = ["STATUSES", "Certificate"]
+
+STATUSES = ("proved", "refuted", "inconclusive")
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """One checked claim. ``status`` is proved, refuted (with a ``counterexample``) or inconclusive
+    (with the ``reason``); ``expected`` is the status the claim should have (negative controls
+    expect refuted); ``margin`` how far from failing (method-specific, stated in ``method``)."""
+
+    claim: str
+    set: str
+    method: str
+    status: str
+    expected: str = "proved"
+    margin: float | None = None
+    seconds: float = 0.0
+    counterexample: dict | None = None
+    reason: str = ""
+    details: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for name in ("status", "expected"):
+            if getattr(self, name) not in STATUSES:
+                raise ValueError(f"certificate {name} must be one of {STATUSES}, got {getattr(self, name)!r}")
+
+    @property
+    def as_expected(self) -> bool:
+        """True when the outcome is the expected one."""
+        return self.status == self.expected
+
+    def to_dict(self) -> dict:
+        """JSON-friendly form (margins that are not finite become None)."""
+        margin = self.margin if self.margin is None or math.isfinite(self.margin) else None
+        return {"claim": self.claim, "set": self.set, "method": self.method, "status": self.status,
+                "expected": self.expected, "margin": margin, "seconds": self.seconds,
+                "counterexample": self.counterexample, "reason": self.reason, "details": self.details}
