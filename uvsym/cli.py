@@ -125,6 +125,43 @@ def _cmd_codegen(args) -> int:
     return 0
 
 
+def _cmd_verify(args) -> int:
+    import importlib
+    import time
+
+    from uvsym.report.markdown import write_json
+
+    available = derivations()
+    names = args.names or list(available)
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise UnknownNameError(f"unknown derivation(s) {unknown}; known: {', '.join(available)}")
+    everything, failures = [], 0
+    for name in names:
+        module = importlib.import_module(available[name].module)
+        if not hasattr(module, "claims"):
+            continue
+        started = time.perf_counter()
+        certificates = module.claims()
+        rows = [c.to_dict() for c in certificates]
+        failures += sum(not c.as_expected for c in certificates)
+        out_dir = Path(args.out) / name
+        out_dir.mkdir(parents=True, exist_ok=True)
+        write_json(out_dir / "proofs.json", [{**row, "seconds": round(row["seconds"], 3)} for row in rows])
+        everything += [{"derivation": name, **row} for row in rows]
+        if not args.json:
+            print(f"{name}: {len(rows)} claims in {time.perf_counter() - started:.1f} s "
+                  f"(written to {out_dir / 'proofs.json'})")
+            print(_table([[r["claim"], r["set"][:40], r["method"][:40], r["status"], r["expected"],
+                           "-" if r["margin"] is None else f"{r['margin']:.3g}", f"{r['seconds']:.2f}"]
+                          for r in rows], ["claim", "set", "method", "status", "expected", "margin", "s"]) + "\n")
+    if args.json:
+        print(json.dumps(everything, indent=2))
+    elif failures:
+        print(f"{failures} claim(s) differ from their expected status", file=sys.stderr)
+    return 1 if failures else 0
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
@@ -159,6 +196,11 @@ def _parser() -> argparse.ArgumentParser:
     codegen.add_argument("--form", choices=FORMS, default="momentum", help="observer form (default momentum)")
     codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi)")
     codegen.set_defaults(run=_cmd_codegen)
+    verify = sub.add_parser("verify", help="check the derivations' claims by machine; exit 1 if any is unexpected")
+    verify.add_argument("names", nargs="*", help="derivations (default: all that make claims)")
+    verify.add_argument("--json", action="store_true", help="print the claims as a JSON list")
+    verify.add_argument("--out", default="reports", help="where proofs.json goes, beside the report (default reports)")
+    verify.set_defaults(run=_cmd_verify)
     return parser
 
 
