@@ -96,3 +96,16 @@ def test_uvsym_verify_prints_json_writes_proofs_and_sets_the_exit_code(tmp_path,
 
     monkeypatch.setattr(study, "claims", lambda: [Certificate("wrong", "set", "method", "refuted")])
     assert main(["verify", "actuator-observers", "--out", str(tmp_path)]) == 1
+
+
+def test_gain_synthesis_places_the_decay_and_is_certified():
+    from uvsym.errors import UvsymError
+    from uvsym.verify.synthesis import synthesize_observer_gain
+
+    A = np.array([[0.0, 1.0], [-2.0, -0.1]])  # lightly damped oscillator, position measured
+    C = np.array([[1.0, 0.0]])
+    design = synthesize_observer_gain(A, C, decay=1.0)
+    assert_proved(design.certificate)
+    assert max(np.linalg.eigvals(A - design.L @ C).real) <= -1.0 + 1e-9
+    with pytest.raises(UvsymError, match="no observer gain"):
+        synthesize_observer_gain(A, np.zeros((1, 2)), decay=1.0)  # nothing measured: nothing to place
