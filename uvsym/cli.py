@@ -65,12 +65,18 @@ def _format_value(value) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in value) + "]" if isinstance(value, tuple) else f"{value:.6g}"
 
 
-def _cmd_report(args) -> int:
+def _selected_derivations(names: list[str]) -> tuple[dict, list[str]]:
+    """(installed derivations, the names asked for or all); UnknownNameError for a name not installed."""
     available = derivations()
-    names = args.names or list(available)
+    names = names or list(available)
     unknown = [n for n in names if n not in available]
     if unknown:
         raise UnknownNameError(f"unknown derivation(s) {unknown}; known: {', '.join(available) or 'none installed'}")
+    return available, names
+
+
+def _cmd_report(args) -> int:
+    available, names = _selected_derivations(args.names)
     out_root = Path(args.out)
     for index, name in enumerate(names, 1):
         build = available[name].load()
@@ -131,11 +137,7 @@ def _cmd_verify(args) -> int:
 
     from uvsym.report.markdown import write_json
 
-    available = derivations()
-    names = args.names or list(available)
-    unknown = [n for n in names if n not in available]
-    if unknown:
-        raise UnknownNameError(f"unknown derivation(s) {unknown}; known: {', '.join(available)}")
+    available, names = _selected_derivations(args.names)
     everything, failures = [], 0
     for name in names:
         module = importlib.import_module(available[name].module)
