@@ -30,7 +30,10 @@ def test_every_core_paper_claim_comes_out_as_expected(claims):
 def test_counterexamples_really_violate_their_claims(claims):
     for certificate in (c for c in claims if c.status == "refuted"):
         example = certificate.counterexample
-        if "A" in example:  # an eigenpair of a vertex: A v = lambda v with Re(lambda) > -gamma
+        if "x" in example:  # a velocity of the fault-tolerant loop where V' > -gamma nu'nu
+            assert _loop_V_dot(certificate.claim, list(example["x"].values())) > -example["gamma"] * sum(
+                v * v for v in example["x"].values())
+        elif "A" in example:  # an eigenpair of a vertex: A v = lambda v with Re(lambda) > -gamma
             A, v = np.array(example["A"]), np.array(example["eigenvector_real"])
             assert max(np.linalg.eigvals(A).real) > -example["gamma"]
             assert np.linalg.norm(v) > 0
@@ -49,6 +52,33 @@ def test_counterexamples_really_violate_their_claims(claims):
                                                          vector("tau_d_dot"), K)).ravel()
             claimed = np.asarray(observer.error_matrix(tau_d, K)).dot(e)
             assert np.max(np.abs(derived - claimed)) > 1e-6 * max(1.0, np.max(np.abs(derived)))
+
+
+def _loop_V_dot(claim: str, nu) -> float:
+    """V' = 2 nu' M nu_dot of the section 3.2 loop, rebuilt here from the model and the faults' definitions."""
+    from uvsym import vehicle
+
+    model = vehicle("otter3dof")
+    nu = np.asarray(nu, dtype=float)
+    B = np.asarray(model.B(np.zeros(3), np.zeros(3), np.zeros(2), 0.0, 0.0))
+    u_d = -50.0 * B.T @ nu
+    if "paper's estimates" in claim:
+        u_d = np.array([u_d[0] - 13.0043, u_d[1] / 0.8001])
+    else:
+        assert "no correction" in claim
+    u = np.array([u_d[0] + 13.0, 0.8 * u_d[1]])  # thruster T_L bias 13 N, T_R factor 0.8
+    nu_dot = np.asarray(model.nu_dot(np.zeros(3), nu, u, 0.0, 0.0)).ravel()
+    return float(2.0 * nu @ model.M @ nu_dot)
+
+
+def test_fault_tolerant_loop_is_proved_only_with_exact_correction(claims):
+    loop = {c.claim.split(": ")[0]: c for c in claims if c.claim.startswith("Section 3.2")}
+    statuses = {name.split(", ", 1)[1].rstrip(")"): c.status for name, c in loop.items()}
+    assert statuses == {"healthy": "proved", "faults corrected with exact estimates": "proved",
+                        "faults, no correction": "refuted", "faults corrected with the paper's estimates": "refuted"}
+    for certificate in loop.values():
+        if certificate.status == "proved":
+            assert certificate.margin > 0 and certificate.details["boxes"] > 1
 
 
 def test_exact_positive_definiteness():
@@ -109,3 +139,70 @@ def test_gain_synthesis_places_the_decay_and_is_certified():
     assert max(np.linalg.eigvals(A - design.L @ C).real) <= -1.0 + 1e-9
     with pytest.raises(UvsymError, match="no observer gain"):
         synthesize_observer_gain(A, np.zeros((1, 2)), decay=1.0)  # nothing measured: nothing to place
+
+
+def test_interval_enclosure_holds_at_sampled_points():
+    from uvsym.verify.interval import IntervalFunction
+
+    x = ca.SX.sym("x", 3)
+    expression = ca.vertcat(x[0] * x[1] - ca.sin(x[2]) * ca.fabs(x[0]), ca.fmax(x[0], 0.3) / (2 + x[1] ** 2),
+                            ca.exp(x[2]) * ca.cos(x[0] * x[1]), ca.tanh(x[0]) ** 3,
+                            ca.if_else(x[0] < x[1], x[2], -x[0]), ca.sqrt(1 + x[1] ** 2), 1 / (x[0] - 10))
+    function = ca.Function("f", [x], [expression])
+    rng = np.random.default_rng(3)
+    centre, half = rng.normal(size=(500, 3)) * 3, rng.uniform(0, 2, size=(500, 3))
+    bounds = IntervalFunction(function)(centre - half, centre + half)
+    points = centre + half * rng.uniform(-1, 1, size=(500, 3))
+    values = np.asarray(function.map(500)(points.T)).T
+    assert np.all(values >= bounds.lo) and np.all(values <= bounds.hi)
+    # where |x_0| has its kink inside a box the box is not smooth
+    straddles = (centre[:, 0] - half[:, 0] < 0) & (centre[:, 0] + half[:, 0] > 0)
+    assert not np.any(bounds.smooth[straddles])
+    # a point box of an exact expression encloses the exact value within a few ulps
+    exact = IntervalFunction(ca.Function("g", [x], [x[0] * x[1] + x[2]]))([[0.1, 0.2, 0.3]], [[0.1, 0.2, 0.3]])
+    assert exact.lo[0, 0] < 0.1 * 0.2 + 0.3 < exact.hi[0, 0] and exact.hi[0, 0] - exact.lo[0, 0] < 1e-15
+
+
+def test_interval_evaluation_names_what_it_cannot_do():
+    from uvsym.errors import VerificationError
+    from uvsym.verify.interval import IntervalFunction
+
+    x = ca.SX.sym("x", 2)
+    with pytest.raises(VerificationError, match="atan2"):
+        IntervalFunction(ca.Function("f", [x], [ca.atan2(x[0], x[1])]))
+    with pytest.raises(VerificationError, match="lower bound above"):
+        IntervalFunction(ca.Function("f", [x], [x[0]]))([[1.0, 0.0]], [[0.0, 1.0]])
+
+
+def test_region_decrease_proves_refutes_and_gives_up_honestly():
+    from uvsym.verify.region import region_decrease
+
+    x = ca.SX.sym("x", 2)
+    V = ca.dot(x, x)
+    stable = ca.vertcat(-x[0] + 0.1 * x[1] ** 2, -x[1] - 0.2 * x[0] * x[1])
+    proved = region_decrease("toy", V, stable, x, 0.5, [-2, -2], [2, 2], 0.1)
+    assert_proved(proved)
+    # V' = -2|x|^2 + 0.2 x0 x1^2 - 0.4 x0 x1^2 >= -2|x|^2 - 0.2 |x0| x1^2: the bound has room
+    grid = np.linspace(-2, 2, 41)
+    worst = max(-2 * (a * a + b * b) - 0.2 * a * b * b + 0.5 * (a * a + b * b) for a in grid for b in grid)
+    assert worst <= 0 and proved.margin > 0
+    # a quadratic term that wins far from the equilibrium
+    unstable = ca.vertcat(-x[0] + x[1] ** 2, -x[1] - 0.2 * x[0] * x[1])
+    refuted = region_decrease("toy, big term", V, unstable, x, 0.5, [-2, -2], [2, 2], 0.1, expected="refuted")
+    assert_refuted(refuted)
+    a, b = refuted.counterexample["x"].values()
+    assert 2 * a * (-a + b * b) + 2 * b * (-b - 0.2 * a * b) > -0.5 * (a * a + b * b)
+    # a constant push: V' > 0 right next to the equilibrium
+    pushed = region_decrease("toy, pushed", V, stable + ca.vertcat(0.1, 0), x, 0.5, [-2, -2], [2, 2], 0.1)
+    assert pushed.status == "refuted" and pushed.counterexample["V_dot"] > pushed.counterexample["bound"]
+    tight = region_decrease("toy, too few boxes", V, stable, x, 0.99, [-2, -2], [2, 2], 0.1, max_boxes=10)
+    assert tight.status == "inconclusive" and "boxes" in tight.reason
+
+
+def test_region_decrease_rejects_a_box_without_the_equilibrium():
+    from uvsym.errors import VerificationError
+    from uvsym.verify.region import region_decrease
+
+    x = ca.SX.sym("x", 2)
+    with pytest.raises(VerificationError, match="equilibrium"):
+        region_decrease("toy", ca.dot(x, x), -x, x, 0.5, [0.5, -1], [1, 1], 0.1)

@@ -16,6 +16,7 @@ __all__ = [
     "SimulationError",
     "ObserverError",
     "CodegenError",
+    "VerificationError",
 ]
 
 
@@ -57,6 +58,10 @@ class ObserverError(UvsymError, ValueError):
 
 class CodegenError(UvsymError, RuntimeError):
     """C code could not be generated, compiled or loaded (names the compiler command and its output)."""
+
+
+class VerificationError(UvsymError, ValueError):
+    """A claim cannot be checked as posed (unsupported operation, malformed region, wrong sizes)."""
 
 
 class UnknownNameError(UvsymError, KeyError):

@@ -61,8 +61,12 @@ class ActuatorObserver:
     error_dynamics: ca.Function
 
 
-def actuator_observer(model: Model, kind: str, form: str = "paper") -> ActuatorObserver:
+def actuator_observer(model: Model, kind: str, form: str = "paper",
+                      require_assumption_1: bool = True) -> ActuatorObserver:
     """Build the observer of ``kind`` (proportional, bias, constant) for ``model``.
+
+    ``require_assumption_1=False`` builds the paper's proportional observer on a coupled M anyway
+    (to show by machine that it can diverge there; never for use).
 
     Raises
     ------
@@ -76,7 +80,8 @@ def actuator_observer(model: Model, kind: str, form: str = "paper") -> ActuatorO
     if form not in FORMS:
         raise ObserverError(f"unknown observer form {form!r}; known: {', '.join(FORMS)}")
     M = model.M
-    if kind == "proportional" and form == "paper" and not np.allclose(M, np.diag(np.diag(M)), rtol=0, atol=1e-12):
+    coupled = not np.allclose(M, np.diag(np.diag(M)), rtol=0, atol=1e-12)
+    if require_assumption_1 and kind == "proportional" and form == "paper" and coupled:
         raise ObserverError(f"{model.name}: the paper's proportional observer needs a diagonal mass matrix "
                             "(Assumption 1: CG = CB, symmetric vehicle); use form='momentum'")
     n = model.dof

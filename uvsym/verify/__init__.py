@@ -2,8 +2,10 @@
 
 from uvsym.verify.certificate import STATUSES, Certificate
 from uvsym.verify.identity import prove_identity
+from uvsym.verify.interval import IntervalFunction
 from uvsym.verify.lyapunov import exact_positive_definite, lyapunov_decrease
+from uvsym.verify.region import region_decrease
 from uvsym.verify.synthesis import GainSynthesis, synthesize_observer_gain
 
-__all__ = ["STATUSES", "Certificate", "GainSynthesis", "exact_positive_definite", "lyapunov_decrease",
-           "prove_identity", "synthesize_observer_gain"]
+__all__ = ["STATUSES", "Certificate", "GainSynthesis", "IntervalFunction", "exact_positive_definite",
+           "lyapunov_decrease", "prove_identity", "region_decrease", "synthesize_observer_gain"]

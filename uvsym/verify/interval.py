@@ -1,0 +1,272 @@
+"""Interval extension of a CasADi SX Function, with outward rounding, over many boxes at once.
+
+``IntervalFunction(f)`` replays ``f``'s instruction list (the same graph CasADi evaluates and
+generates C from) on intervals: each work variable holds (k,) lower and upper bounds, one
+entry per box, so a batch of boxes costs one numpy operation per instruction. Every rounded
+operation moves its bounds outward by one unit in the last place (``numpy.nextafter``);
+IEEE +, -, *, / and sqrt are correctly rounded, so that encloses the exact result. Library
+functions (exp, sin, tanh, ...) are accurate to within an ulp in glibc; they are widened by
+``LIBM_ULPS`` units. The enclosure is therefore rigorous: every value the function takes on a
+box lies between the bounds returned for it.
+
+``smooth`` says, per box, whether no non-smooth operation (abs, min/max, comparisons,
+conditionals, sign, floor) has its kink inside the box; Taylor-type arguments need it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from uvsym.errors import VerificationError
+
+__all__ = ["IntervalFunction", "Intervals"]
+
+LIBM_ULPS = 2
+_NAMES = {getattr(ca, name): name[3:].lower() for name in dir(ca) if name.startswith("OP_")}
+
+
+def _down(x, ulps: int = 1):
+    for _ in range(ulps):
+        x = np.nextafter(x, -np.inf)
+    return x
+
+
+def _up(x, ulps: int = 1):
+    for _ in range(ulps):
+        x = np.nextafter(x, np.inf)
+    return x
+
+
+def _clean(lo, hi):
+    """NaN bounds (0 * inf, inf - inf) become the widest bound."""
+    return np.where(np.isnan(lo), -np.inf, lo), np.where(np.isnan(hi), np.inf, hi)
+
+
+def _mul(a, b):
+    with np.errstate(invalid="ignore"):
+        products = np.stack([a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]])
+    products = np.where(np.isnan(products), 0.0, products)  # 0 * inf: a zero factor wins
+    return _down(products.min(axis=0)), _up(products.max(axis=0))
+
+
+def _div(a, b):
+    straddles = (b[0] <= 0.0) & (b[1] >= 0.0)
+    with np.errstate(all="ignore"):
+        quotients = np.stack([a[0] / b[0], a[0] / b[1], a[1] / b[0], a[1] / b[1]])
+    lo, hi = _clean(_down(np.nanmin(quotients, axis=0)), _up(np.nanmax(quotients, axis=0)))
+    return np.where(straddles, -np.inf, lo), np.where(straddles, np.inf, hi)
+
+
+def _even(a, function):
+    """An even function increasing on x >= 0 (x^2, cosh, x^4)."""
+    f_lo, f_hi = function(np.abs(a[0])), function(np.abs(a[1]))
+    lo = np.where(a[0] >= 0, f_lo, np.where(a[1] <= 0, f_hi, function(np.zeros_like(a[0]))))
+    return lo, np.maximum(f_lo, f_hi)
+
+
+def _increasing(function, ulps: int = LIBM_ULPS):
+    def apply(a):
+        with np.errstate(all="ignore"):
+            return _clean(_down(function(a[0]), ulps), _up(function(a[1]), ulps))
+    return apply
+
+
+def _periodic(a, function, peak: float, trough: float):
+    """sin or cos: endpoint values, and +-1 where the box holds a peak or a trough."""
+    with np.errstate(all="ignore"):
+        f0, f1 = function(a[0]), function(a[1])
+    lo, hi = _down(np.minimum(f0, f1), LIBM_ULPS), _up(np.maximum(f0, f1), LIBM_ULPS)
+    two_pi = 2.0 * np.pi
+    slack = 1e-9  # rounding of the peak positions: when in doubt the box holds one
+    holds_peak = np.floor((a[1] - peak) / two_pi + slack) >= np.ceil((a[0] - peak) / two_pi - slack)
+    holds_trough = np.floor((a[1] - trough) / two_pi + slack) >= np.ceil((a[0] - trough) / two_pi - slack)
+    wide = ~np.isfinite(a[0]) | ~np.isfinite(a[1]) | (a[1] - a[0] >= two_pi)
+    hi = np.where(holds_peak | wide, 1.0, np.minimum(hi, 1.0))
+    lo = np.where(holds_trough | wide, -1.0, np.maximum(lo, -1.0))
+    return lo, hi
+
+
+def _truth(a):
+    """(certainly nonzero, certainly zero) per box."""
+    return (a[0] > 0) | (a[1] < 0), (a[0] == 0) & (a[1] == 0)
+
+
+def _indicator(true, false):
+    """Interval of a 0/1 value, and whether it is undecided (a kink inside the box)."""
+    undecided = ~true & ~false
+    return (np.where(true, 1.0, 0.0), np.where(false, 0.0, 1.0)), undecided
+
+
+def _compare(op, a, b):
+    if op == ca.OP_LT:
+        return _indicator(a[1] < b[0], a[0] >= b[1])
+    if op == ca.OP_LE:
+        return _indicator(a[1] <= b[0], a[0] > b[1])
+    point_equal = (a[0] == a[1]) & (b[0] == b[1]) & (a[0] == b[0])
+    disjoint = (a[1] < b[0]) | (b[1] < a[0])
+    if op == ca.OP_EQ:
+        return _indicator(point_equal, disjoint)
+    return _indicator(disjoint, point_equal)
+
+
+def _power(a, exponent: float):
+    if exponent == int(exponent):
+        n = int(exponent)
+        if n == 0:
+            return np.ones_like(a[0]), np.ones_like(a[0])
+        if n < 0:
+            return _div((np.ones_like(a[0]), np.ones_like(a[0])), _power(a, -n))
+        if n % 2 == 0:
+            lo, hi = _even(a, lambda x: x**n)
+        else:
+            lo, hi = a[0] ** n, a[1] ** n
+        return _clean(_down(lo, n), _up(hi, n))
+    if np.any(a[0] < 0):
+        raise VerificationError(f"interval power x^{exponent} needs x >= 0 on every box")
+    lo, hi = (a[0] ** exponent, a[1] ** exponent) if exponent > 0 else (a[1] ** exponent, a[0] ** exponent)
+    return _clean(_down(lo, LIBM_ULPS), _up(hi, LIBM_ULPS))
+
+
+_MONOTONE = {
+    ca.OP_EXP: np.exp, ca.OP_TANH: np.tanh, ca.OP_ATAN: np.arctan, ca.OP_SINH: np.sinh,
+    ca.OP_ASINH: np.arcsinh, ca.OP_LOG1P: np.log1p, ca.OP_EXPM1: np.expm1,
+}
+_POSITIVE_DOMAIN = {ca.OP_LOG: np.log, ca.OP_SQRT: np.sqrt}
+
+
+@dataclass(frozen=True)
+class Intervals:
+    """Bounds of a function's outputs over k boxes: lo, hi (k, m); smooth (k,) as in the module docstring."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+    smooth: np.ndarray
+
+
+class IntervalFunction:
+    """The interval extension of an SX Function with one dense vector input x (n,) and output (m,)."""
+
+    def __init__(self, function: ca.Function):
+        if not function.is_a("SXFunction"):
+            raise VerificationError(f"{function.name()}: interval evaluation needs an SX Function (expand MX first)")
+        if function.n_in() != 1 or function.n_out() != 1:
+            raise VerificationError(f"{function.name()}: interval evaluation takes one input and one output, "
+                                    f"got {function.n_in()} and {function.n_out()}")
+        self.function = function
+        self.n_in, self.n_out = function.nnz_in(0), function.nnz_out(0)
+        if self.n_in != function.numel_in(0):
+            raise VerificationError(f"{function.name()}: the input must be dense")
+        self.program = [(function.instruction_id(k), function.instruction_input(k), function.instruction_output(k),
+                         function.instruction_constant(k)) for k in range(function.n_instructions())]
+        unsupported = sorted({_NAMES.get(op, str(op)) for op, *_ in self.program if not self._supported(op)})
+        if unsupported:
+            raise VerificationError(f"{function.name()}: interval evaluation does not support the operation(s) "
+                                    f"{', '.join(unsupported)}")
+        self.sparsity_out = function.sparsity_out(0)
+
+    @staticmethod
+    def _supported(op: int) -> bool:
+        return op in _MONOTONE or op in _POSITIVE_DOMAIN or op in {
+            ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST, ca.OP_ASSIGN, ca.OP_ADD, ca.OP_SUB, ca.OP_MUL, ca.OP_DIV,
+            ca.OP_NEG, ca.OP_SQ, ca.OP_TWICE, ca.OP_INV, ca.OP_SIN, ca.OP_COS, ca.OP_COSH, ca.OP_FABS, ca.OP_SIGN,
+            ca.OP_FMIN, ca.OP_FMAX, ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE, ca.OP_NOT, ca.OP_AND, ca.OP_OR,
+            ca.OP_IF_ELSE_ZERO, ca.OP_CONSTPOW, ca.OP_POW, ca.OP_FLOOR, ca.OP_CEIL}
+
+    def __call__(self, lo, hi) -> Intervals:
+        """Bounds of the output over the boxes ``[lo, hi]`` (each (k, n) or (n,))."""
+        lo, hi = np.atleast_2d(np.asarray(lo, dtype=float)), np.atleast_2d(np.asarray(hi, dtype=float))
+        if lo.shape != hi.shape or lo.shape[1] != self.n_in:
+            raise VerificationError(f"{self.function.name()}: boxes must be (k, {self.n_in}) lower and upper "
+                                    f"bounds, got {lo.shape} and {hi.shape}")
+        if np.any(~(lo <= hi)):
+            raise VerificationError(f"{self.function.name()}: a box has a lower bound above its upper bound (or NaN)")
+        k = lo.shape[0]
+        work: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        out_lo, out_hi = np.zeros((k, self.n_out)), np.zeros((k, self.n_out))
+        smooth = np.ones(k, dtype=bool)
+        for op, inputs, outputs, constant in self.program:
+            if op == ca.OP_INPUT:
+                work[outputs[0]] = (lo[:, inputs[1]], hi[:, inputs[1]])
+            elif op == ca.OP_OUTPUT:
+                out_lo[:, outputs[1]], out_hi[:, outputs[1]] = work[inputs[0]]
+            elif op == ca.OP_CONST:
+                work[outputs[0]] = (np.full(k, constant), np.full(k, constant))
+            else:
+                args = [work[i] for i in inputs]
+                result, kink = self._apply(op, args)
+                if kink is not None:
+                    smooth &= ~kink
+                work[outputs[0]] = result
+        return Intervals(out_lo, out_hi, smooth)
+
+    def _apply(self, op: int, args):
+        """(lo, hi) of one operation, and where its kink lies inside the box (None for smooth ones)."""
+        a = args[0]
+        b = args[1] if len(args) > 1 else None
+        if op == ca.OP_ASSIGN:
+            return a, None
+        if op == ca.OP_ADD:
+            return _clean(_down(a[0] + b[0]), _up(a[1] + b[1])), None
+        if op == ca.OP_SUB:
+            return _clean(_down(a[0] - b[1]), _up(a[1] - b[0])), None
+        if op == ca.OP_MUL:
+            return _mul(a, b), None
+        if op == ca.OP_DIV:
+            return _div(a, b), None
+        if op == ca.OP_INV:
+            return _div((np.ones_like(a[0]), np.ones_like(a[0])), a), None
+        if op == ca.OP_NEG:
+            return (-a[1], -a[0]), None
+        if op == ca.OP_TWICE:
+            return (2.0 * a[0], 2.0 * a[1]), None
+        if op == ca.OP_SQ:
+            lo, hi = _even(a, np.square)
+            return _clean(_down(lo), _up(hi)), None
+        if op == ca.OP_COSH:
+            lo, hi = _even(a, np.cosh)
+            return _clean(_down(lo, LIBM_ULPS), _up(hi, LIBM_ULPS)), None
+        if op in _MONOTONE:
+            return _increasing(_MONOTONE[op])(a), None
+        if op in _POSITIVE_DOMAIN:
+            if np.any(a[1] < 0 if op == ca.OP_SQRT else a[1] <= 0):
+                raise VerificationError(f"interval {_NAMES[op]} of an argument outside its domain on a box")
+            clipped = (np.maximum(a[0], 0.0), a[1])
+            return _increasing(_POSITIVE_DOMAIN[op], 1 if op == ca.OP_SQRT else LIBM_ULPS)(clipped), None
+        if op == ca.OP_SIN:
+            return _periodic(a, np.sin, np.pi / 2, -np.pi / 2), None
+        if op == ca.OP_COS:
+            return _periodic(a, np.cos, 0.0, np.pi), None
+        if op in (ca.OP_CONSTPOW, ca.OP_POW):
+            if not np.all(b[0] == b[1]) or not np.all(b[0] == b[0][0]):
+                raise VerificationError("interval power needs a constant exponent")
+            return _power(a, float(b[0][0])), None
+        if op == ca.OP_FABS:
+            kink = (a[0] < 0) & (a[1] > 0)
+            return (np.where(a[0] >= 0, a[0], np.where(a[1] <= 0, -a[1], 0.0)),
+                    np.maximum(np.abs(a[0]), np.abs(a[1]))), kink
+        if op == ca.OP_SIGN:
+            return (np.sign(a[0]), np.sign(a[1])), (a[0] <= 0) & (a[1] >= 0) & (a[0] < a[1])
+        if op in (ca.OP_FLOOR, ca.OP_CEIL):
+            function = np.floor if op == ca.OP_FLOOR else np.ceil
+            lo, hi = function(a[0]), function(a[1])
+            return (lo, hi), lo != hi
+        if op in (ca.OP_FMIN, ca.OP_FMAX):
+            pick = np.minimum if op == ca.OP_FMIN else np.maximum
+            return (pick(a[0], b[0]), pick(a[1], b[1])), np.maximum(a[0], b[0]) <= np.minimum(a[1], b[1])
+        if op in (ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE):
+            return _compare(op, a, b)
+        true, false = _truth(a)
+        if op == ca.OP_NOT:
+            return _indicator(false, true)
+        if op in (ca.OP_AND, ca.OP_OR):
+            b_true, b_false = _truth(b)
+            if op == ca.OP_AND:
+                return _indicator(true & b_true, false | b_false)
+            return _indicator(true | b_true, false & b_false)
+        # OP_IF_ELSE_ZERO(condition, value)
+        lo = np.where(true, b[0], np.where(false, 0.0, np.minimum(b[0], 0.0)))
+        hi = np.where(true, b[1], np.where(false, 0.0, np.maximum(b[1], 0.0)))
+        return (lo, hi), ~true & ~false
