@@ -53,7 +53,7 @@ def test_report_models_is_deterministic(tmp_path):
     assert main(["report", "models", "--out", str(first)]) == 0
     assert main(["report", "models", "--out", str(second)]) == 0
     names = sorted(p.name for p in (first / "models").iterdir())
-    assert names == ["report.md", "results.json", "step_responses.svg"]
+    assert names == ["report.html", "report.md", "results.json", "step_responses.svg"]
     for name in names:
         assert (first / "models" / name).read_bytes() == (second / "models" / name).read_bytes(), name
     results = json.loads((first / "models" / "results.json").read_text())
@@ -65,7 +65,7 @@ def test_committed_models_report_is_current(tmp_path):
     """The committed reports/models text files are what the current code builds."""
     committed = Path(__file__).resolve().parents[1] / "reports" / "models"
     assert main(["report", "models", "--out", str(tmp_path)]) == 0
-    for name in ("report.md", "results.json"):
+    for name in ("report.md", "report.html", "results.json"):
         assert (tmp_path / "models" / name).read_text() == (committed / name).read_text(), f"stale {name}"
 
 
@@ -82,7 +82,14 @@ def test_actuator_observers_reproduction_meets_every_target_and_is_committed(tmp
                    "fig8_actuation_with_ftc"):
         assert (built / f"{figure}.svg").read_text().startswith("<?xml"), figure
     committed = Path(__file__).resolve().parents[1] / "reports" / "actuator-observers"
-    assert (built / "report.md").read_text() == (committed / "report.md").read_text(), "stale report.md"
+    for name in ("report.md", "report.html"):
+        assert (built / name).read_text() == (committed / name).read_text(), f"stale {name}"
+    # the C package the report links to: compiled cleanly by the build, equal to Python, committed as built
+    assert results["c"]["compiled"] and results["c"]["max_relative_difference"] <= 1e-12
+    sources = sorted(p.relative_to(built) for p in (built / "c").rglob("*") if p.is_file())
+    assert sources == sorted(p.relative_to(committed) for p in (committed / "c").rglob("*") if p.is_file())
+    for relative in sources:
+        assert (built / relative).read_bytes() == (committed / relative).read_bytes(), f"stale {relative}"
     # results.json at the precision a reader uses (the last of its 9 digits may move with libm)
     _assert_close(results, json.loads((committed / "results.json").read_text()), "results.json")
 

@@ -76,6 +76,8 @@ def _selected_derivations(names: list[str]) -> tuple[dict, list[str]]:
 
 
 def _cmd_report(args) -> int:
+    from uvsym.report.html import write_html
+
     available, names = _selected_derivations(args.names)
     out_root = Path(args.out)
     for index, name in enumerate(names, 1):
@@ -87,6 +89,8 @@ def _cmd_report(args) -> int:
             print(f"[{_index}/{len(names)}] {_name}: {message}", file=sys.stderr, flush=True)
 
         build(out_dir, progress)
+        progress("report.html")
+        write_html(out_dir)
         print(f"wrote {out_dir}")
     return 0
 
