@@ -164,3 +164,16 @@ def test_generated_sources_allocate_nothing(package):
     for call in ("malloc(", "calloc(", "realloc(", "free("):
         assert call not in code, call
     assert "static casadi_real w[" in code  # work buffers are static
+
+
+def test_check_package_compiles_compares_and_names_a_broken_source(tmp_path, observers):
+    from uvsym.codegen.check import check_package
+
+    name, description, functions = observers
+    write_package(tmp_path, functions, name, "double", description)
+    check = check_package(tmp_path, functions, name, calls=3)
+    assert check.max_relative_difference <= 1e-12 and "-Werror" in check.flags
+    source = tmp_path / "src" / f"{name}.c"
+    source.write_text(source.read_text() + "\nstatic int unused_and_warned;\n")
+    with pytest.raises(CodegenError, match="does not compile cleanly"):
+        check_package(tmp_path, functions, name, calls=3)
