@@ -33,6 +33,7 @@ PAPER = {"isolation_time_s": 3.1788, "thruster_fault_type": "bias", "f_bar_a": 1
          "rudder_fault_type": "proportional", "f_bar_p": 0.8001}
 TARGETS = {"f_bar_a": 0.01, "f_bar_p": 0.001, "isolation_time_s": 5.0, "cross_track_ratio": 5.0}
 TRUE = {"f_a": 13.0, "f_p": 0.8}
+ROUNDING_SHOWN_AS_ZERO = 1e-12  # coefficients this small in derived matrices are M M^-1 rounding residues
 
 
 def _run(scenario: Scenario, correct: bool):
@@ -307,7 +308,9 @@ def _derived_gains(scenario: Scenario) -> str:
         R = latex(observer.R(nu, tau_d, K)[0], 4)
         parts.append(f"- {kind} ({observer.form} form), first entry of R: $R_1 = {R}$; "
                      f"$L = \\partial R / \\partial \\nu$:\n\n$$L_{{{kind[0]}}} = "
-                     f"{latex(observer.L(nu, tau_d, K), 4)}$$")
+                     f"{latex(observer.L(nu, tau_d, K), 4)}$$\n\n  and the error dynamics $\\dot e = A e$ "
+                     f"derived along the faulty plant (constant $\\tau_d$):\n\n$$A_{{{kind[0]}}} = "
+                     f"{latex(observer.error_matrix(tau_d, K), 4, zero_below=ROUNDING_SHOWN_AS_ZERO)}$$")
     return "\n\n".join(parts)
 
 
@@ -337,20 +340,26 @@ def _c_section(c: dict) -> str:
 
 
 def _report(scenario: Scenario, r: dict, checks: dict) -> str:
+    def versus(key: str, digits: int) -> list[str]:
+        """reproduced, paper, reproduced - paper (or whether the two agree, for a decision)."""
+        ours, paper = r[key], PAPER[key]
+        if isinstance(paper, str):
+            return [ours, paper, "same" if ours == paper else "**differs**"]
+        return [_fmt(ours, digits), _fmt(paper), f"{ours - paper:+.{max(digits - 3, 2)}g}"]
+
     rows = [
-        ["isolation time (s)", _fmt(r["isolation_time_s"], 4), _fmt(PAPER["isolation_time_s"]),
-         f"<= {TARGETS['isolation_time_s']:g}"],
-        ["thruster fault type", r["thruster_fault_type"], PAPER["thruster_fault_type"], "bias"],
-        ["f_bar_a, thruster bias (N)", _fmt(r["f_bar_a"], 7), _fmt(PAPER["f_bar_a"]), f"13 +- {TARGETS['f_bar_a']}"],
-        ["rudder fault type", r["rudder_fault_type"], PAPER["rudder_fault_type"], "proportional"],
-        ["f_bar_p, rudder factor (-)", _fmt(r["f_bar_p"], 7), _fmt(PAPER["f_bar_p"]), f"0.8 +- {TARGETS['f_bar_p']}"],
+        ["isolation time (s)", *versus("isolation_time_s", 4), f"<= {TARGETS['isolation_time_s']:g}"],
+        ["thruster fault type", *versus("thruster_fault_type", 0), "bias"],
+        ["f_bar_a, thruster bias (N)", *versus("f_bar_a", 7), f"13 +- {TARGETS['f_bar_a']}"],
+        ["rudder fault type", *versus("rudder_fault_type", 0), "proportional"],
+        ["f_bar_p, rudder factor (-)", *versus("f_bar_p", 7), f"0.8 +- {TARGETS['f_bar_p']}"],
         ["cross-track RMS without / with correction (m)",
          f"{_fmt(r['cross_track_rms_m_without_ftc'], 4)} / {_fmt(r['cross_track_rms_m_with_ftc'], 4)} "
-         f"(ratio {_fmt(r['cross_track_ratio'], 3)})", "not given (Figs. 4, 7)",
+         f"(ratio {_fmt(r['cross_track_ratio'], 3)})", "not given (Figs. 4, 7)", "-",
          f"ratio >= {TARGETS['cross_track_ratio']:g}"],
         ["miss at the dock without / with correction (m)",
          f"{_fmt(r['dock_miss_m_without_ftc'], 3)} / {_fmt(r['dock_miss_m_with_ftc'], 3)}",
-         "misses / docks", f"dock radius {DOCK_RADIUS_M}"],
+         "misses / docks", "-", f"dock radius {DOCK_RADIUS_M}"],
     ]
     decisions = [[c, d["kind"], _fmt(d["time_s"], 4), _fmt(d["f_bar"], 7), _fmt(d["variance"], 3)]
                  for c, d in r["channel_decisions"].items()]
@@ -382,7 +391,7 @@ loop. Every number below is computed by `uvsym report actuator-observers`.
 
 ## Paper versus reproduction
 
-{markdown_table(["quantity", "reproduced", "paper", "target"], rows)}
+{markdown_table(["quantity", "reproduced", "paper", "reproduced - paper", "target"], rows)}
 
 {status}
 
@@ -415,7 +424,9 @@ loop. Every number below is computed by `uvsym report actuator-observers`.
 ## Derived by CasADi (not typed)
 
 The numbers are entries of M (kg, kg m, kg m^2), shown to 4 digits (the code keeps every bit);
-$k_i$ are the gains, $\\tau_{{d,i}}$ the desired forces:
+$k_i$ are the gains, $\\tau_{{d,i}}$ the desired forces. In $A$, coefficients below
+{ROUNDING_SHOWN_AS_ZERO:g} (residues of $M M^{{-1}}$ in double precision) are shown as 0 and those
+within it of 1 as 1:
 
 {_derived_gains(scenario)}
 

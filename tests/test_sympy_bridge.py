@@ -67,3 +67,11 @@ def test_latex_uses_the_papers_symbols():
 def test_mx_is_refused_with_a_clear_error():
     with pytest.raises(UvsymError, match="SX"):
         to_sympy(ca.MX.sym("x"))
+
+
+def test_latex_can_hide_rounding_residues_but_only_when_asked():
+    k = ca.SX.sym("K", 2)
+    expression = ca.vertcat(1e-17 * k[0] - 1.0000000000000002 * k[1], 0.5 * k[0])
+    assert "10^{-17}" in latex(expression, 4)
+    shown = latex(expression, 4, zero_below=1e-12)
+    assert "10^{-17}" not in shown and "1.0" not in shown and "- k_{1}" in shown and "0.5 k_{0}" in shown

@@ -110,12 +110,22 @@ def _symbol_latex(name: str) -> str:
     return f"{tex}_{{{index}}}"
 
 
-def latex(expression, digits: int = 6) -> str:
+def latex(expression, digits: int = 6, zero_below: float = 0.0) -> str:
     """LaTeX of an SX or sympy expression, symbols named as in the papers (``nu_3`` -> ``\\nu_{3}``).
 
-    Constants are shown to ``digits`` significant digits (the conversion itself keeps all).
+    Constants are shown to ``digits`` significant digits (the conversion itself keeps all);
+    coefficients of magnitude below ``zero_below`` are shown as 0 and those that round to 1 as 1
+    (for rounding residues such as those of ``M M^-1`` in doubles: say so where it is used).
     """
     value = expression if isinstance(expression, (sp.Basic, sp.MatrixBase)) else to_sympy(expression)
     names = {s: _symbol_latex(s.name) for s in value.free_symbols}
-    rounded = value.xreplace({n: sp.Float(n, digits) for n in value.atoms(sp.Float)})
+
+    def shown(number: sp.Float):
+        if abs(number) < zero_below:
+            return sp.Integer(0)
+        if zero_below and abs(abs(number) - 1) < zero_below:
+            return sp.Integer(1 if number > 0 else -1)
+        return sp.Float(number, digits)
+
+    rounded = value.xreplace({n: shown(n) for n in value.atoms(sp.Float)})
     return sp.latex(rounded, symbol_names=names, mat_delim="", mat_str="bmatrix")
