@@ -82,7 +82,7 @@ def test_actuator_observers_reproduction_meets_every_target_and_is_committed(tmp
                    "fig8_actuation_with_ftc"):
         assert (built / f"{figure}.svg").read_text().startswith("<?xml"), figure
     committed = Path(__file__).resolve().parents[1] / "reports" / "actuator-observers"
-    for name in ("report.md", "report.html"):
+    for name in ("report.md", "report.html", *(p.name for p in committed.glob("*.svg"))):
         assert (built / name).read_text() == (committed / name).read_text(), f"stale {name}"
     # the C package the report links to: compiled cleanly by the build, equal to Python, committed as built
     assert results["c"]["compiled"] and results["c"]["max_relative_difference"] <= 1e-12

@@ -56,7 +56,7 @@ def _div(a, b):
     straddles = (b[0] <= 0.0) & (b[1] >= 0.0)
     with np.errstate(all="ignore"):
         quotients = np.stack([a[0] / b[0], a[0] / b[1], a[1] / b[0], a[1] / b[1]])
-    lo, hi = _clean(_down(np.nanmin(quotients, axis=0)), _up(np.nanmax(quotients, axis=0)))
+    lo, hi = _clean(_down(quotients.min(axis=0)), _up(quotients.max(axis=0)))  # inf/inf: unbounded
     return np.where(straddles, -np.inf, lo), np.where(straddles, np.inf, hi)
 
 
@@ -83,7 +83,8 @@ def _periodic(a, function, peak: float, trough: float):
     slack = 1e-9  # rounding of the peak positions: when in doubt the box holds one
     holds_peak = np.floor((a[1] - peak) / two_pi + slack) >= np.ceil((a[0] - peak) / two_pi - slack)
     holds_trough = np.floor((a[1] - trough) / two_pi + slack) >= np.ceil((a[0] - trough) / two_pi - slack)
-    wide = ~np.isfinite(a[0]) | ~np.isfinite(a[1]) | (a[1] - a[0] >= two_pi)
+    # far from 0 the peak test loses precision: such boxes get the whole range
+    wide = ~(np.abs(a[0]) < 1e6) | ~(np.abs(a[1]) < 1e6) | (a[1] - a[0] >= two_pi)
     hi = np.where(holds_peak | wide, 1.0, np.minimum(hi, 1.0))
     lo = np.where(holds_trough | wide, -1.0, np.maximum(lo, -1.0))
     return lo, hi
