@@ -283,8 +283,9 @@ def build(out_dir: Path, progress) -> None:
     results["c"] = _generated_c(scenario, out_dir / "c")
     progress("machine-checked claims")
     results["claims"] = [{key: row[key] for key in ("claim", "set", "method", "status", "expected")}
-                         | {"margin": None if row["margin"] is None else float(f"{row['margin']:.3g}")}
-                         for row in (c.to_dict() for c in claims())]
+                         | {"margin": None if row["margin"] is None else float(f"{row['margin']:.3g}"),
+                            "counterexample": certificate.counterexample_summary()}
+                         for certificate, row in ((c, c.to_dict()) for c in claims())]
     write_json(out_dir / "results.json", _round(results))
 
     progress("figures")
@@ -319,6 +320,10 @@ def _claims_table(rows: list[dict]) -> str:
                           [[r["claim"], r["set"], r["method"], f"**{r['status']}**" if r["status"] != r["expected"]
                             else r["status"], r["expected"], "-" if r["margin"] is None else f"{r['margin']:.3g}"]
                            for r in rows])
+
+
+def _counterexamples(rows: list[dict]) -> str:
+    return "\n".join(f"- {r['claim']}: {r['counterexample']}" for r in rows if r["counterexample"]) or "- none"
 
 
 def _c_section(c: dict) -> str:
@@ -440,6 +445,11 @@ graph. Negative controls are expected to be refuted; a refuted claim's counterex
 `proofs.json` (`uvsym verify actuator-observers --json`).
 
 {_claims_table(r["claims"])}
+
+Counterexamples of the refuted claims (the test suite substitutes each one back and checks that it
+violates its claim):
+
+{_counterexamples(r["claims"])}
 
 ## Generated C
 

@@ -206,3 +206,11 @@ def test_region_decrease_rejects_a_box_without_the_equilibrium():
     x = ca.SX.sym("x", 2)
     with pytest.raises(VerificationError, match="equilibrium"):
         region_decrease("toy", ca.dot(x, x), -x, x, 0.5, [0.5, -1], [1, 1], 0.1)
+
+
+def test_counterexample_summaries_say_what_fails(claims):
+    refuted = [c for c in claims if c.status == "refuted"]
+    assert refuted and all(c.counterexample_summary() for c in refuted)
+    assert all(c.counterexample_summary() == "" for c in claims if c.status == "proved")
+    region = next(c for c in refuted if "V_dot" in c.counterexample)
+    assert f"V' = {region.counterexample['V_dot']:.3g} >" in region.counterexample_summary()

@@ -37,6 +37,19 @@ class Certificate:
         """True when the outcome is the expected one."""
         return self.status == self.expected
 
+    def counterexample_summary(self, digits: int = 3) -> str:
+        """One line on what the counterexample shows ("" without one), numbers to ``digits`` digits."""
+        example = self.counterexample or {}
+        if "eigenvalue_real" in example:
+            return (f"a vertex's eigenvalue has real part {example['eigenvalue_real']:.{digits}g} "
+                    f"> -gamma = {0.0 - example['gamma']:.{digits}g}")
+        if "V_dot" in example:
+            point = ", ".join(f"{name} = {value:.{digits}g}" for name, value in example["x"].items())
+            return f"at {point}: V' = {example['V_dot']:.{digits}g} > {example['bound']:.{digits}g}"
+        if "relative_difference" in example:
+            return f"the two sides differ by {example['relative_difference']:.{digits}g} (relative) at a random point"
+        return ""
+
     def to_dict(self) -> dict:
         """JSON-friendly form (margins that are not finite become None)."""
         margin = self.margin if self.margin is None or math.isfinite(self.margin) else None
