@@ -60,8 +60,9 @@ class _Decrease:
             half = np.maximum(hi - centre, centre - lo)
             with np.errstate(invalid="ignore"):
                 spread = np.nansum(np.maximum(np.abs(slope.lo), np.abs(slope.hi)) * half, axis=1)
-            mean_value = np.nextafter(at_centre + spread, np.inf)  # sum of rounded terms: a few ulps, widened
-            mean_value = np.where(np.isfinite(mean_value), mean_value * (1 + 1e-12) + 1e-300, np.inf)
+            # the products and the sum are rounded: widen upward by far more than their few ulps
+            mean_value = at_centre + spread + 1e-12 * (np.abs(at_centre) + spread) + 1e-300
+            mean_value = np.where(np.isfinite(mean_value), mean_value, np.inf)
             bound = np.where(plain.smooth, np.minimum(bound, mean_value), bound)
         return bound
 
