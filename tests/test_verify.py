@@ -161,6 +161,10 @@ def test_interval_enclosure_holds_at_sampled_points():
     # a point box of an exact expression encloses the exact value within a few ulps
     exact = IntervalFunction(ca.Function("g", [x], [x[0] * x[1] + x[2]]))([[0.1, 0.2, 0.3]], [[0.1, 0.2, 0.3]])
     assert exact.lo[0, 0] < 0.1 * 0.2 + 0.3 < exact.hi[0, 0] and exact.hi[0, 0] - exact.lo[0, 0] < 1e-15
+    # exact float results are not widened: an equilibrium evaluates to exactly 0
+    balanced = IntervalFunction(ca.Function("h", [x], [(x[0] - 13.0) + 13.0 + 0.5 * x[1] * x[2]]))
+    balanced = balanced([[0.0] * 3], [[0.0] * 3])
+    assert balanced.lo[0, 0] == 0.0 == balanced.hi[0, 0]
 
 
 def test_interval_evaluation_names_what_it_cannot_do():
@@ -195,6 +199,9 @@ def test_region_decrease_proves_refutes_and_gives_up_honestly():
     # a constant push: V' > 0 right next to the equilibrium
     pushed = region_decrease("toy, pushed", V, stable + ca.vertcat(0.1, 0), x, 0.5, [-2, -2], [2, 2], 0.1)
     assert pushed.status == "refuted" and pushed.counterexample["V_dot"] > pushed.counterexample["bound"]
+    # a push too small for a rigorous counterexample near 0: not proved
+    tiny = region_decrease("toy, tiny push", V, stable + ca.vertcat(1e-300, 0), x, 0.5, [-2, -2], [2, 2], 0.1)
+    assert tiny.status in ("refuted", "inconclusive")
     tight = region_decrease("toy, too few boxes", V, stable, x, 0.99, [-2, -2], [2, 2], 0.1, max_boxes=10)
     assert tight.status == "inconclusive" and "boxes" in tight.reason
 

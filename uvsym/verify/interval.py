@@ -4,7 +4,9 @@
 generates C from) on intervals: each work variable holds (k,) lower and upper bounds, one
 entry per box, so a batch of boxes costs one numpy operation per instruction. Every rounded
 operation moves its bounds outward by one unit in the last place (``numpy.nextafter``);
-IEEE +, -, *, / and sqrt are correctly rounded, so that encloses the exact result. Library
+IEEE +, -, *, / and sqrt are correctly rounded, so that encloses the exact result; results
+that are exact anyway (sums whose TwoSum error is 0, and 0 * x, 0 / x) stay unwidened, so that
+an equilibrium evaluates to exactly 0. Library
 functions (exp, sin, tanh, ...) are accurate to within an ulp in glibc; they are widened by
 ``LIBM_ULPS`` units. The enclosure is therefore rigorous: every value the function takes on a
 box lies between the bounds returned for it.
@@ -45,11 +47,41 @@ def _clean(lo, hi):
     return np.where(np.isnan(lo), -np.inf, lo), np.where(np.isnan(hi), np.inf, hi)
 
 
+def _is_zero(a):
+    return (a[0] == 0) & (a[1] == 0)
+
+
+def _exact_zeros(result, a, b=None):
+    """``result`` with exact zeros where an operand is exactly 0 (no rounding to widen there)."""
+    zero = _is_zero(a) if b is None else _is_zero(a) | _is_zero(b)
+    return np.where(zero, 0.0, result[0]), np.where(zero, 0.0, result[1])
+
+
+def _rounded_sum(x, y, direction: float):
+    """x + y rounded towards ``direction`` (+-inf): left as it is where the float sum is exact.
+
+    Exactness by Knuth's TwoSum: the rounding error of ``s = x + y`` is
+    ``(x - (s - (s - x))) + (y - (s - x))``, exactly, barring overflow.
+    """
+    with np.errstate(all="ignore"):
+        total = x + y
+        y_part = total - x
+        error = (x - (total - y_part)) + (y - y_part)
+    exact = (error == 0) & np.isfinite(total)
+    return np.where(exact, total, np.nextafter(total, direction))
+
+
+def _sum(a, b, sign: float):
+    """a + sign b with bounds rounded outward only where the float sums are inexact."""
+    b_lo, b_hi = (b[0], b[1]) if sign > 0 else (-b[1], -b[0])
+    return _clean(_rounded_sum(a[0], b_lo, -np.inf), _rounded_sum(a[1], b_hi, np.inf))
+
+
 def _mul(a, b):
     with np.errstate(invalid="ignore"):
         products = np.stack([a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]])
     products = np.where(np.isnan(products), 0.0, products)  # 0 * inf: a zero factor wins
-    return _down(products.min(axis=0)), _up(products.max(axis=0))
+    return _exact_zeros((_down(products.min(axis=0)), _up(products.max(axis=0))), a, b)
 
 
 def _div(a, b):
@@ -210,13 +242,13 @@ class IntervalFunction:
         if op == ca.OP_ASSIGN:
             return a, None
         if op == ca.OP_ADD:
-            return _clean(_down(a[0] + b[0]), _up(a[1] + b[1])), None
+            return _sum(a, b, 1.0), None
         if op == ca.OP_SUB:
-            return _clean(_down(a[0] - b[1]), _up(a[1] - b[0])), None
+            return _sum(a, b, -1.0), None
         if op == ca.OP_MUL:
             return _mul(a, b), None
         if op == ca.OP_DIV:
-            return _div(a, b), None
+            return _exact_zeros(_div(a, b), a), None
         if op == ca.OP_INV:
             return _div((np.ones_like(a[0]), np.ones_like(a[0])), a), None
         if op == ca.OP_NEG:
@@ -225,7 +257,7 @@ class IntervalFunction:
             return (2.0 * a[0], 2.0 * a[1]), None
         if op == ca.OP_SQ:
             lo, hi = _even(a, np.square)
-            return _clean(_down(lo), _up(hi)), None
+            return _exact_zeros(_clean(_down(lo), _up(hi)), a), None
         if op == ca.OP_COSH:
             lo, hi = _even(a, np.cosh)
             return _clean(_down(lo, LIBM_ULPS), _up(hi, LIBM_ULPS)), None

@@ -149,6 +149,12 @@ def region_decrease(claim: str, V: ca.SX, x_dot: ca.SX, x: ca.SX, gamma: float, 
         return certificate("refuted", "W = V' + gamma x'x > 0 at a point near the equilibrium (interval evaluation)",
                            margin=float(-decrease.W(near_zero, near_zero).lo[0, 0]),
                            counterexample=counterexample(near_zero))
+    zero = np.zeros((1, n))
+    gradient_at_zero = decrease.grad(zero, zero)
+    if decrease.W(zero, zero).hi[0, 0] > 0 or np.any(gradient_at_zero.lo != 0) or np.any(gradient_at_zero.hi != 0):
+        return certificate("inconclusive", "Taylor expansion at the equilibrium",
+                           reason="W or its gradient at x = 0 is not exactly 0 in interval arithmetic "
+                                  "(is x = 0 an equilibrium of the loop?), and no counterexample was found")
     cube, pivot = rho, None
     for _ in range(HALVINGS + 1):
         proved, pivot = _cube_certificate(decrease, cube)
