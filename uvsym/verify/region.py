@@ -28,7 +28,7 @@ import numpy as np
 from uvsym.errors import VerificationError
 from uvsym.progress import ProgressBar
 from uvsym.verify.certificate import Certificate
-from uvsym.verify.interval import IntervalFunction
+from uvsym.verify.interval import IntervalFunction, Intervals
 from uvsym.verify.lyapunov import exact_positive_definite
 
 __all__ = ["region_decrease"]
@@ -66,6 +66,11 @@ class _Decrease:
             bound = np.where(plain.smooth, np.minimum(bound, mean_value), bound)
         return bound
 
+    def at_equilibrium(self) -> tuple[Intervals, Intervals, Intervals]:
+        """Bounds of W, grad W and vec(Hessian of W) at x = 0."""
+        zero = np.zeros((1, self.n))
+        return self.W(zero, zero), self.grad(zero, zero), self.hess(zero, zero)
+
     def certainly_positive(self, points) -> np.ndarray:
         """(k,) True where W(point) > 0 rigorously."""
         return self.W(points, points).lo[:, 0] > 0
@@ -91,11 +96,11 @@ def _cube_certificate(decrease: _Decrease, rho: float) -> tuple[bool, Fraction |
     return exact_positive_definite(negated)
 
 
-def _equilibrium_counterexample(decrease: _Decrease, scale: np.ndarray) -> np.ndarray | None:
+def _equilibrium_counterexample(decrease: _Decrease, gradient: Intervals, hessian: Intervals,
+                                scale: np.ndarray) -> np.ndarray | None:
     """A point near 0 where W > 0 rigorously, when the gradient or Hessian of W at 0 allows one."""
-    zero = np.zeros((1, decrease.n))
-    g = 0.5 * (decrease.grad(zero, zero).lo[0] + decrease.grad(zero, zero).hi[0])
-    H = 0.5 * (decrease.hess(zero, zero).lo[0] + decrease.hess(zero, zero).hi[0]).reshape(decrease.n, decrease.n)
+    g = 0.5 * (gradient.lo[0] + gradient.hi[0])
+    H = 0.5 * (hessian.lo[0] + hessian.hi[0]).reshape(decrease.n, decrease.n)
     eigenvalues, vectors = np.linalg.eigh(0.5 * (H + H.T))
     directions = [g] if np.any(g != 0) else []
     directions += [vectors[:, -1]] if eigenvalues[-1] > 0 else []
@@ -144,14 +149,13 @@ def region_decrease(claim: str, V: ca.SX, x_dot: ca.SX, x: ca.SX, gamma: float, 
                 "bound": float(-gamma * np.dot(point, point))}
 
     scale = np.minimum(-lower, upper)
-    near_zero = _equilibrium_counterexample(decrease, scale)
+    value_at_zero, gradient_at_zero, hessian_at_zero = decrease.at_equilibrium()
+    near_zero = _equilibrium_counterexample(decrease, gradient_at_zero, hessian_at_zero, scale)
     if near_zero is not None:
         return certificate("refuted", "W = V' + gamma x'x > 0 at a point near the equilibrium (interval evaluation)",
                            margin=float(-decrease.W(near_zero, near_zero).lo[0, 0]),
                            counterexample=counterexample(near_zero))
-    zero = np.zeros((1, n))
-    gradient_at_zero = decrease.grad(zero, zero)
-    if decrease.W(zero, zero).hi[0, 0] > 0 or np.any(gradient_at_zero.lo != 0) or np.any(gradient_at_zero.hi != 0):
+    if value_at_zero.hi[0, 0] > 0 or np.any(gradient_at_zero.lo != 0) or np.any(gradient_at_zero.hi != 0):
         return certificate("inconclusive", "Taylor expansion at the equilibrium",
                            reason="W or its gradient at x = 0 is not exactly 0 in interval arithmetic "
                                   "(is x = 0 an equilibrium of the loop?), and no counterexample was found")
