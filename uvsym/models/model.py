@@ -21,6 +21,8 @@ from uvsym.errors import ModelError
 from uvsym.kinematics import J, Rzyx
 from uvsym.models.hydrodynamics import current_velocity, current_velocity_derivative
 from uvsym.models.parameters import ParameterSet
+from uvsym.systems.signals import Signals
+from uvsym.systems.system import System
 
 __all__ = ["Model", "VehicleEquations", "assemble"]
 
@@ -96,6 +98,21 @@ class Model:
     def force_units(self) -> tuple[str, ...]:
         """Units of tau and h."""
         return FORCE_UNITS[self.dof]
+
+    def as_system(self) -> System:
+        """This vehicle as a :class:`~uvsym.systems.System`: ``x = [eta; nu]``, ``u`` the actuator
+        inputs, no disturbance, ``p = (V_c, beta_c)`` the current (nominal 0), ``y = x``."""
+        x = Signals(self.state_labels, self.state_units, group="state")
+        u = Signals(self.input_labels, self.input_units, group="input")
+        p = Signals(("V_c", "beta_c"), ("m/s", "rad"),
+                    ("current speed", "direction the current flows towards, from north"), "parameter")
+        xs, us, ds, ps = ca.SX.sym("x", x.size), ca.SX.sym("u", u.size), ca.SX.sym("d", 0), ca.SX.sym("p", 2)
+        f = ca.Function("f", [xs, us, ds, ps], [self.f(xs, us, ps)], ["x", "u", "d", "p"], ["x_dot"])
+        h = ca.Function("h", [xs, us, ps], [xs], ["x", "u", "p"], ["y"])
+        return System(name=self.name, description=self.description, x=x, u=u, d=Signals(group="disturbance"),
+                      p=p, y=x.renamed(group="output"), f=f, h=h, p0=np.zeros(2), u_min=self.u_min,
+                      u_max=self.u_max, constants=self.parameters,
+                      source=f"uvsym vehicle library ({self.name}): M (nu' - nu_c') + h(eta, nu_r) = tau(u)")
 
     def summary(self) -> dict:
         """JSON-friendly description: sizes, labels, units, mass matrix and parameters."""

@@ -23,7 +23,13 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-__all__ = ["SampledObserver", "sampled_observer"]
+from uvsym.conventions import FORCE_LABELS
+from uvsym.models.model import Model
+from uvsym.observers.actuator import actuator_observer
+from uvsym.observers.base import Observer
+from uvsym.systems.signals import Signals
+
+__all__ = ["SampledObserver", "actuator_fault_observer", "gain_units", "sampled_observer"]
 
 
 def _drop_residue(matrix: ca.SX, inputs: list, samples: int = 8, rtol: float = 1e-12) -> ca.SX:
@@ -105,3 +111,43 @@ def sampled_observer(function: ca.Function, dt: float) -> SampledObserver:
     step = ca.Function("observer_step", [s, eta, nu, tau_d, K], [s_next, f_hat],
                        ["s", "eta", "nu", "tau_d", "K"], ["s_next", "f_hat"])
     return SampledObserver(step=step, pieces=pieces, n=n, nnz_P=nnz_P, nnz_L=nnz_L)
+
+
+def gain_units(kind: str, form: str, force_units: tuple[str, ...]) -> tuple[str, ...]:
+    """Units of the gain entries K of an actuator observer (rate k tau_d^2 or k, per channel)."""
+    if kind == "proportional":
+        unit = "1/(s (N or N m)^2)" if form == "momentum" else "kg^2/(s (N or N m)^2)"
+        return (unit,) * len(force_units)
+    return ("1/s" if form == "momentum" else "kg^2/s",) * len(force_units)
+
+
+def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "paper",
+                            name: str | None = None) -> Observer:
+    """The core paper's ``kind`` observer (Theorems 1-3) on ``model`` as an :class:`Observer`.
+
+    step(s, y = [eta; nu], u = tau_d, p = K) -> (s_next, f_hat): the sampled-data form of this
+    module. Reads the model's states by name and ``tau_d.<force>`` (the desired generalised force,
+    N and N m); publishes ``f_hat.<force>`` (the fault estimate: factors for proportional, forces
+    otherwise). The continuous observer is kept in ``equations["continuous"]``.
+    """
+    continuous = actuator_observer(model, kind, form)
+    sampled = sampled_observer(continuous.function, dt)
+    n = model.dof
+    forces = Signals(FORCE_LABELS[n], model.force_units, group="force")
+    f_units = ("-",) * n if kind == "proportional" else model.force_units
+    states = Signals(model.state_labels, model.state_units, group="measurement")
+    name = name or kind
+    s_names = tuple(f"{name}.s{i}" for i in range(sampled.state_size))
+    y, u = ca.SX.sym("y", 2 * n), ca.SX.sym("u", n)
+    s, K_sym = ca.SX.sym("s", sampled.state_size), ca.SX.sym("p", n)
+    s_next, f_hat = sampled.step(s, y[:n], y[n:], u, K_sym)
+    step = ca.Function(f"{name}_step", [s, y, u, K_sym], [s_next, f_hat], ["s", "y", "u", "p"], ["s_next", "out"])
+    return Observer(
+        name=name, step=step, dt=dt, p0=K,
+        state=Signals(s_names, ("-",) * len(s_names), group="state"),
+        reads_y=states, reads_u=forces.renamed(prefix="tau_d.", group="desired force"),
+        params=Signals(tuple(f"K.{f}" for f in forces), gain_units(kind, form, model.force_units), group="gain"),
+        publishes=Signals(tuple(f"f_hat.{f}" for f in forces), f_units, group="fault estimate"),
+        init=lambda y0, u0, p: sampled.initial_state(y0[:n], y0[n:], u0, p),
+        error_dynamics=continuous.error_dynamics, equations={"continuous": continuous.function},
+        description=f"{kind} actuator-fault observer of {model.name} ({form} form), sampled every {dt:g} s")

@@ -1,0 +1,121 @@
+"""The estimator contract: Observer validation, the actuator observers and the Luenberger observer as implementations."""
+
+import casadi as ca
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+import uvsym
+from uvsym.errors import ModelError, ObserverError
+from uvsym.observers.base import Observer, observer
+from uvsym.observers.discrete import actuator_fault_observer, sampled_observer
+from uvsym.observers.luenberger import luenberger_observer
+from uvsym.observers.actuator import actuator_observer
+from uvsym.systems import Signals, signals, system
+
+X = signals(("pos", "m", "position"), ("vel", "m/s", "velocity"), group="state")
+
+
+def _oscillator():
+    """x'' = -4 x - 0.4 x' + u, position measured: a linear plant with a known solution."""
+    return system("oscillator", "damped oscillator", x=X, u=signals(("force", "m/s^2"), group="input"),
+                  y=signals(("pos_meas", "m"), group="output"),
+                  rhs=lambda x, u, d, p: ca.vertcat(x[1], -4 * x[0] - 0.4 * x[1] + u[0]),
+                  output=lambda x, u, p: x[0])
+
+
+def test_observer_rejects_mismatched_sizes():
+    step = ca.Function("bad_step", [ca.SX.sym("s", 2), ca.SX.sym("y"), ca.SX.sym("u", 0), ca.SX.sym("p", 0)],
+                       [ca.SX.zeros(2), ca.SX.zeros(1)], ["s", "y", "u", "p"], ["s_next", "out"])
+    with pytest.raises(ObserverError, match="step input s has 2 entries but 3"):
+        Observer("bad", step, Signals(("a", "b", "c"), ("-",) * 3), Signals(("y",), ("-",)), Signals(), Signals(),
+                 Signals(("o",), ("-",)), np.zeros(0), 0.1)
+    with pytest.raises(ObserverError, match="must map"):
+        a = ca.SX.sym("a")
+        Observer("bad", ca.Function("g", [a], [a]), Signals(), Signals(), Signals(),
+                 Signals(), Signals(), np.zeros(0), 0.1)
+
+
+def test_observer_builder_errors_name_the_problem():
+    common = dict(state=signals(("a", "-")), reads_y=signals(("b", "-")), reads_u=signals(),
+                  publishes=signals(("a_hat", "-")), dt=0.1)
+    with pytest.raises(ObserverError, match="symbols other than s, y, u, p: \\['k'\\]"):
+        observer("luen", step=lambda s, y, u, p: (s + ca.SX.sym("k") * y, s), **common)
+    with pytest.raises(ObserverError, match="out with 2 entries, expected 1"):
+        observer("luen", step=lambda s, y, u, p: (s, ca.vertcat(s, s)), **common)
+    with pytest.raises(ObserverError, match="name 'my-observer'"):
+        observer("my-observer", step=lambda s, y, u, p: (s, s), **common)
+    with pytest.raises(ObserverError, match="dt must be positive"):
+        observer("luen", step=lambda s, y, u, p: (s, s), **{**common, "dt": float("nan")})
+    obs = observer("luen", step=lambda s, y, u, p: (0.5 * s + 0.5 * y, s), **common)
+    with pytest.raises(ObserverError, match=r"Y must be \(N, 1\)"):
+        obs.run(np.zeros((4, 2)), np.zeros((4, 0)))
+    with pytest.raises(ObserverError, match="non-finite"):
+        obs.initial_state([float("nan")], [])
+
+
+def test_observer_run_matches_hand_recursion():
+    obs = observer("avg", step=lambda s, y, u, p: (p[0] * s + (1 - p[0]) * y, s), state=signals(("a", "-")),
+                   reads_y=signals(("b", "-")), reads_u=signals(), params=signals(("lam", "-")), p0=[0.5],
+                   publishes=signals(("a_hat", "-")), dt=0.1)
+    S, out = obs.run(np.ones((4, 1)), np.zeros((4, 0)), p=[0.25])
+    expected = [0.0]
+    for _ in range(4):
+        expected.append(0.25 * expected[-1] + 0.75)
+    np.testing.assert_allclose(S.ravel(), expected, rtol=1e-15)
+    np.testing.assert_allclose(out.ravel(), expected[:4], rtol=1e-15)
+    with pytest.raises(ObserverError, match="no signal named \\['lambda'\\]; known: lam"):
+        obs.parameters({"lambda": 0.2})
+
+
+@pytest.mark.parametrize("kind", ["proportional", "bias", "constant"])
+def test_actuator_observer_is_an_observer_with_the_same_numbers(kind):
+    """The Observer form runs the same sampled-data step as the closed loop's observers."""
+    model = uvsym.vehicle("otter3dof")
+    K, dt = np.array([2.0, 1.5, 3.0]), 0.05
+    obs = actuator_fault_observer(model, kind, dt, K, form="momentum")
+    sampled = sampled_observer(actuator_observer(model, kind, "momentum").function, dt)
+    assert obs.reads_y.names == model.state_labels
+    assert obs.publishes.names == ("f_hat.X", "f_hat.Y", "f_hat.N")
+    assert obs.publishes.units == (("-",) * 3 if kind == "proportional" else ("N", "N", "N m"))
+    rng = np.random.default_rng(1)
+    Y, U = rng.normal(size=(30, 6)), rng.uniform(5, 20, size=(30, 3))
+    S, out = obs.run(Y, U)
+    s = sampled.initial_state(Y[0, :3], Y[0, 3:], U[0], K)
+    np.testing.assert_allclose(S[0], s, rtol=0, atol=0)
+    for k in range(30):
+        s, f_hat = (np.asarray(v).ravel() for v in sampled.step(s, Y[k, :3], Y[k, 3:], U[k], K))
+        np.testing.assert_allclose(out[k], f_hat, rtol=1e-12, atol=1e-12)
+    assert obs.error_dynamics.name_in() == ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"]
+
+
+def test_luenberger_estimates_a_linear_plant_and_its_error_dynamics_are_A_minus_LC():
+    plant = _oscillator()
+    L = np.array([[3.0], [2.0]])
+    dt = 0.01
+    obs = luenberger_observer(plant, L, dt, steps=2)
+    assert obs.publishes.names == ("pos_hat", "vel_hat", "r_pos_meas")
+    # true trajectory of the free oscillator from x(0) = (1, 0), exactly
+    A = np.array([[0.0, 1.0], [-4.0, -0.4]])
+    N = 1500
+    X_true = np.array([expm(A * dt * k) @ [1.0, 0.0] for k in range(N)])
+    S, out = obs.run(X_true[:, :1], np.zeros((N, 1)))
+    assert np.abs(out[-1, :2] - X_true[-1]).max() < 1e-8  # |e| ~ exp(-1.7 t) from |e(0)| = 1
+    assert abs(out[0, 2] - 1.0) < 1e-15  # residual y - C xhat at xhat = x_op = 0
+    # the derived error dynamics of a linear plant are exactly (A - L C) e
+    rng = np.random.default_rng(0)
+    e, x = rng.normal(size=2), rng.normal(size=2)
+    e_dot = np.asarray(obs.error_dynamics(e, x, [0.3], np.zeros(0), np.zeros(0))).ravel()
+    np.testing.assert_allclose(e_dot, (A - L @ np.array([[1.0, 0.0]])) @ e, rtol=1e-13, atol=1e-13)
+
+
+def test_luenberger_rejects_bad_gains_and_discrete_plants():
+    plant = _oscillator()
+    with pytest.raises(ObserverError, match=r"\(2, 1\) matrix"):
+        luenberger_observer(plant, np.ones((1, 2)), 0.01)
+    with pytest.raises(ObserverError, match="finite"):
+        luenberger_observer(plant, [[np.nan], [1.0]], 0.01)
+    with pytest.raises(ObserverError, match="is discrete"):
+        luenberger_observer(plant.discretize(0.01, "zoh"), np.ones((2, 1)), 0.01)
+    with pytest.raises(ModelError):
+        signals(("a", "m"), ("a", "m"))

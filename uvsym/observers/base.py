@@ -1,0 +1,154 @@
+"""The estimator contract: every observer, filter or adaptive estimator is an :class:`Observer`.
+
+An estimator is a discrete step, sampled every ``dt`` seconds::
+
+    s_{k+1}, out_k = step(s_k, y_k, u_k, p)
+
+as one named ``casadi.Function`` with inputs ``(s, y, u, p)`` and outputs ``(s_next, out)``:
+``s`` its own state, ``y`` the measurements it reads, ``u`` the known inputs it reads (commands,
+desired forces), ``p`` its parameters (gains, tuning), ``out`` what it publishes (estimates,
+residuals, fault estimates). ``out_k`` belongs to sample k (it may use ``y_k``).
+
+What a new estimator implements (like ``scipy.integrate.OdeSolver``'s ``_step_impl``):
+
+- the step expression, built from CasADi symbols (``observer(..., step=...)`` takes a Python
+  callable ``(s, y, u, p) -> (s_next, out)`` and makes the named Function);
+- the names and units of what it reads (``reads_y``, ``reads_u``: the names of loop signals),
+  of its state, parameters (with default values ``p0``) and of what it publishes;
+- its initial state from the first sample (``init(y0, u0, p) -> s0``, default zeros);
+- where the method has one, its symbolic error dynamics (``error_dynamics``, a Function with
+  named inputs, for ``uvsym verify``).
+
+What it gets for free: it runs in any closed loop wired by signal name (:mod:`uvsym.sim.wiring`),
+scalar or compiled; it exports to C (:mod:`uvsym.codegen`); a report renders its equations
+(:mod:`uvsym.report.sympy_bridge`); its size errors are caught here, before anything runs.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from uvsym.errors import ObserverError
+from uvsym.systems.signals import Signals
+
+__all__ = ["Observer", "observer", "STEP_INPUTS", "STEP_OUTPUTS"]
+
+STEP_INPUTS = ("s", "y", "u", "p")
+STEP_OUTPUTS = ("s_next", "out")
+
+
+@dataclass(frozen=True)
+class Observer:
+    """A discrete-time estimator (module docstring).
+
+    step(s, y, u, p) -> (s_next, out); state, reads_y, reads_u, params, publishes: the Signals of
+    s, y, u, p and out; p0: (n_p,) default parameters; dt: sample period (s); init(y0, u0, p) ->
+    s0 (None: zeros); error_dynamics: symbolic error dynamics for verify, or None; equations:
+    further named Functions a report may render (e.g. the continuous right-hand side).
+    """
+
+    name: str
+    step: ca.Function
+    state: Signals
+    reads_y: Signals
+    reads_u: Signals
+    params: Signals
+    publishes: Signals
+    p0: np.ndarray
+    dt: float
+    init: Callable | None = None
+    error_dynamics: ca.Function | None = None
+    equations: dict = field(default_factory=dict)
+    description: str = ""
+
+    def __post_init__(self):
+        f = self.step
+        if not isinstance(f, ca.Function):
+            raise ObserverError(f"{self.name}: step must be a casadi.Function, got {type(f).__name__}")
+        if tuple(f.name_in()) != STEP_INPUTS or tuple(f.name_out()) != STEP_OUTPUTS:
+            raise ObserverError(f"{self.name}: step must map (s, y, u, p) -> (s_next, out), got "
+                                f"({', '.join(f.name_in())}) -> ({', '.join(f.name_out())})")
+        for i, group in enumerate((self.state, self.reads_y, self.reads_u, self.params)):
+            if f.numel_in(i) != group.size:
+                raise ObserverError(f"{self.name}: step input {STEP_INPUTS[i]} has {f.numel_in(i)} entries but "
+                                    f"{group.size} {group.group} signals are named ({', '.join(group.names)})")
+        for i, group in enumerate((self.state, self.publishes)):
+            if f.numel_out(i) != group.size:
+                raise ObserverError(f"{self.name}: step output {STEP_OUTPUTS[i]} has {f.numel_out(i)} entries but "
+                                    f"{group.size} signals are named ({', '.join(group.names)})")
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise ObserverError(f"{self.name}: sample period dt must be positive and finite (s), got {self.dt}")
+        try:
+            p0 = self.params.vector(self.p0, f"{self.name}: parameters p0")
+        except Exception as exc:
+            raise ObserverError(str(exc)) from None
+        object.__setattr__(self, "p0", p0)
+
+    def parameters(self, p=None) -> np.ndarray:
+        """The parameter vector: ``p0``, or p (array or ``{name: value}``) checked against ``params``."""
+        if p is None:
+            return self.p0
+        try:
+            return self.params.vector(p, f"{self.name}: parameters")
+        except Exception as exc:
+            raise ObserverError(str(exc)) from None
+
+    def initial_state(self, y0, u0, p=None) -> np.ndarray:
+        """The state before the first sample, from the first measurement y0 and input u0."""
+        p = self.parameters(p)
+        try:
+            y0 = self.reads_y.vector(y0, f"{self.name}: y0")
+            u0 = self.reads_u.vector(u0, f"{self.name}: u0")
+        except Exception as exc:
+            raise ObserverError(str(exc)) from None
+        if self.init is None:
+            return np.zeros(self.state.size)
+        s0 = np.asarray(self.init(y0, u0, p), dtype=float).reshape(-1)
+        if s0.size != self.state.size or not np.all(np.isfinite(s0)):
+            raise ObserverError(f"{self.name}: init gave {s0.size} entries (finite: {bool(np.all(np.isfinite(s0)))}),"
+                                f" expected {self.state.size} finite")
+        return s0
+
+    def run(self, Y, U, p=None, s0=None) -> tuple[np.ndarray, np.ndarray]:
+        """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out))."""
+        Y, U = np.atleast_2d(np.asarray(Y, dtype=float)), np.atleast_2d(np.asarray(U, dtype=float))
+        if Y.shape[1] != self.reads_y.size or U.shape[1] != self.reads_u.size or len(Y) != len(U):
+            raise ObserverError(f"{self.name}: Y must be (N, {self.reads_y.size}) and U (N, {self.reads_u.size}), "
+                                f"got {Y.shape} and {U.shape}")
+        p = self.parameters(p)
+        s = self.initial_state(Y[0], U[0], p) if s0 is None else np.asarray(s0, dtype=float)
+        roll = self.step.mapaccum("run", len(Y), [0], [0])
+        S, OUT = roll(s, Y.T, U.T, p)
+        return np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
+
+
+def observer(name: str, *, step: Callable, state: Signals, reads_y: Signals, reads_u: Signals,
+             publishes: Signals, dt: float, params: Signals | None = None, p0=None, **options) -> Observer:
+    """Build an :class:`Observer` from a Python callable ``step(s, y, u, p) -> (s_next, out)`` on SX.
+
+    ``options`` go to :class:`Observer` (init, error_dynamics, equations, description).
+    """
+    params = params if params is not None else Signals(group="parameter")
+    s, y, u, p = (ca.SX.sym(a, g.size) for a, g in zip(STEP_INPUTS, (state, reads_y, reads_u, params)))
+    result = step(s, y, u, p)
+    if not isinstance(result, tuple) or len(result) != 2:
+        raise ObserverError(f"{name}: step must return (s_next, out)")
+    s_next, out = (ca.densify(ca.vec(ca.SX(v))) for v in result)
+    for what, expr, group in (("s_next", s_next, state), ("out", out, publishes)):
+        if expr.numel() != group.size:
+            raise ObserverError(f"{name}: step gives {what} with {expr.numel()} entries, expected {group.size}")
+    stray = sorted({v.name() for v in ca.symvar(ca.vertcat(s_next, out))} -
+                   {v.name() for v in ca.symvar(ca.vertcat(s, y, u, p))})
+    if stray:
+        raise ObserverError(f"{name}: step uses symbols other than s, y, u, p: {stray}")
+    if not re.fullmatch(r"[A-Za-z](_?[A-Za-z0-9])*", name):
+        raise ObserverError(f"observer name {name!r} must start with a letter and hold only letters, digits and "
+                            "single underscores (it names C functions)")
+    function = ca.Function(f"{name}_step", [s, y, u, p], [s_next, out], list(STEP_INPUTS), list(STEP_OUTPUTS))
+    return Observer(name=name, step=function, state=state, reads_y=reads_y, reads_u=reads_u, params=params,
+                    publishes=publishes, p0=np.zeros(params.size) if p0 is None else p0, dt=dt, **options)
