@@ -110,15 +110,16 @@ def _symbol_latex(name: str) -> str:
     return f"{tex}_{{{index}}}"
 
 
-def latex(expression, digits: int = 6, zero_below: float = 0.0) -> str:
+def latex(expression, digits: int = 6, zero_below: float = 0.0, names: dict[str, str] | None = None) -> str:
     """LaTeX of an SX or sympy expression, symbols named as in the papers (``nu_3`` -> ``\\nu_{3}``).
 
     Constants are shown to ``digits`` significant digits (the conversion itself keeps all);
     coefficients of magnitude below ``zero_below`` are shown as 0 and those that round to 1 as 1
     (for rounding residues such as those of ``M M^-1`` in doubles: say so where it is used).
+    ``names`` maps symbol names to their LaTeX, overriding the papers' names.
     """
     value = expression if isinstance(expression, (sp.Basic, sp.MatrixBase)) else to_sympy(expression)
-    names = {s: _symbol_latex(s.name) for s in value.free_symbols}
+    names = {s: (names or {}).get(s.name) or _symbol_latex(s.name) for s in value.free_symbols}
 
     def shown(number: sp.Float):
         if abs(number) < zero_below:
