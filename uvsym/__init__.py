@@ -9,6 +9,7 @@ from uvsym.models import (
     vehicle,
     vehicle_names,
 )
+from uvsym.systems import plant, plant_names
 
 __version__ = "0.1.0"
 
@@ -18,6 +19,8 @@ __all__ = [
     "errors",
     "fixed_thrusters",
     "identifiability",
+    "plant",
+    "plant_names",
     "vectored_thrusters",
     "vehicle",
     "vehicle_names",

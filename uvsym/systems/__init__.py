@@ -6,7 +6,9 @@ zero-order hold or symbolic RK4; a registry of plants beyond the marine vehicles
 """
 
 from uvsym.systems.discretize import discretize, zoh_matrices
+from uvsym.systems.registry import PLANTS, plant, plant_names
 from uvsym.systems.signals import Signals, signals
 from uvsym.systems.system import Linearization, System, system
 
-__all__ = ["Linearization", "Signals", "System", "discretize", "signals", "system", "zoh_matrices"]
+__all__ = ["Linearization", "PLANTS", "Signals", "System", "discretize", "plant", "plant_names", "signals", "system",
+           "zoh_matrices"]
