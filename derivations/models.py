@@ -1,7 +1,7 @@
 """The vehicle library: equations, parameters, agreement with the field's reference simulator.
 
-Writes ``report.md``, ``results.json`` and ``step_responses.svg`` into the given folder. Every
-number in them is computed by this run.
+``uvsym report models`` writes ``report.md``, ``results.json`` and ``step_responses.svg`` into
+the given folder. Every number in them is computed by this run. No claims, no observer sets.
 """
 
 from __future__ import annotations
@@ -14,7 +14,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from uvsym import vehicle, vehicle_names
+from uvsym.derivation import Derivation
 from uvsym.report import latex_matrix, markdown_table, save_svg, write_json
+
+__all__ = ["DERIVATION", "build", "docking_input_matrix", "reference_agreement", "step_response"]
 
 REFERENCE = Path(__file__).with_name("data") / "fossen_pvs_reference.json"
 TOLERANCE = 1e-9  # relative agreement required of nu_dot: max |a - b| / max |b|
@@ -114,8 +117,8 @@ def _fmt(value) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in value) + "]" if isinstance(value, tuple) else f"{value:.6g}"
 
 
-def build(out_dir: Path, progress=lambda message: None) -> dict:
-    """Build the vehicle-library report into ``out_dir``; returns the results written."""
+def build(out_dir: Path, progress=lambda message: None) -> None:
+    """Build the vehicle-library report into ``out_dir``."""
     out_dir = Path(out_dir)
     progress("comparing with the reference simulator")
     agreement = reference_agreement()
@@ -171,4 +174,6 @@ def build(out_dir: Path, progress=lambda message: None) -> dict:
         *[_vehicle_section(name) for name in vehicle_names()],
     ]) + "\n"
     (out_dir / "report.md").write_text(text)
-    return results
+
+
+DERIVATION = Derivation(name="models", title="Vehicle library", build=build)

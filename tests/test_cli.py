@@ -141,10 +141,79 @@ def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path):
 
 def test_codegen_writes_the_package_and_refuses_unknown_sets(tmp_path, capsys):
     assert main(["codegen", "actuator-observers", "-o", str(tmp_path / "pkg"), "--vehicle", "otter3dof"]) == 0
-    assert "uvsym_bias_step" in capsys.readouterr().out
+    assert "uvsym_otter3dof_observers_bias_step" in capsys.readouterr().out
     manifest = json.loads((tmp_path / "pkg" / "manifest.json").read_text())
     assert manifest["precision"] == "double" and len(manifest["functions"]) == 7
     for path in ("Makefile", "CMakeLists.txt", "main.c", "harness.c", "include/uvsym_otter3dof_observers.h"):
         assert (tmp_path / "pkg" / path).exists(), path
     result = run("codegen", "sliding-mode", "-o", str(tmp_path / "x"))
     assert result.returncode == 2 and "unknown observer set" in result.stderr
+
+
+def _install(monkeypatch, **entries):
+    """Make ``entries`` (entry-point name -> object, set on a scratch module) the installed derivations."""
+    import types
+    from importlib.metadata import EntryPoint
+
+    import uvsym.derivation
+
+    module = types.ModuleType("scratch_derivations")
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    points = []
+    for index, (name, value) in enumerate(entries.items()):
+        setattr(module, f"entry{index}", value)
+        points.append(EntryPoint(name, f"{module.__name__}:entry{index}", uvsym.derivation.GROUP))
+    monkeypatch.setattr(uvsym.derivation, "entry_points", lambda group: points)
+
+
+def _tiny_set():
+    """A one-function observer set whose factory takes no options."""
+    import casadi as ca
+
+    from uvsym.codegen.observer_sets import ObserverSet
+    from uvsym.codegen.package import Exported
+
+    x = ca.SX.sym("x", 2)
+    function = ca.Function("bias_step", [x], [-x], ["x"], ["x_next"])
+    return ObserverSet("tiny", "a tiny set", (Exported(function, ("x (-)",), ("x_next (-)",), "minus x"),))
+
+
+def test_the_loader_names_an_entry_point_that_is_not_a_derivation(monkeypatch, capsys):
+    from uvsym.derivation import Derivation, DerivationError, load_derivations
+
+    _install(monkeypatch, good=Derivation("good", "Good", lambda out_dir, progress: None), broken=uvsym.vehicle)
+    with pytest.raises(DerivationError, match="entry point 'broken' = 'scratch_derivations:entry1'.* not a "):
+        load_derivations()
+    assert main(["report", "broken"]) == 2
+    assert "uvsym: error: entry point 'broken'" in capsys.readouterr().err
+    _install(monkeypatch, renamed=Derivation("other", "Other", lambda out_dir, progress: None))
+    with pytest.raises(DerivationError, match="called 'other'"):
+        load_derivations()
+    with pytest.raises(DerivationError, match="not callable: build"):
+        Derivation("none", "None", build=None)
+
+
+def test_codegen_goes_through_the_declared_sets_and_refuses_options_a_set_does_not_take(monkeypatch, tmp_path, capsys):
+    from uvsym.derivation import Derivation
+
+    toy = Derivation("toy", "Toy", lambda out_dir, progress: None, observer_sets={"tiny": _tiny_set})
+    _install(monkeypatch, toy=toy)
+    assert main(["codegen", "--list"]) == 0
+    assert capsys.readouterr().out.splitlines()[2].split()[:3] == ["tiny", "toy", "none"]
+    assert main(["codegen", "tiny", "-o", str(tmp_path / "pkg")]) == 0
+    assert "tiny_bias_step" in capsys.readouterr().out and (tmp_path / "pkg" / "include" / "tiny.h").exists()
+    assert main(["codegen", "tiny", "-o", str(tmp_path / "pkg"), "--vehicle", "otter"]) == 2
+    assert "observer set 'tiny' takes no option --vehicle; its options: none" in capsys.readouterr().err
+    assert main(["codegen", "actuator-observers", "-o", str(tmp_path / "x")]) == 2
+    assert "unknown observer set 'actuator-observers'; known: tiny" in capsys.readouterr().err
+    assert main(["verify", "toy"]) == 0  # a derivation without claims has nothing to check
+
+
+def test_unknown_observer_sets_and_options_are_refused_by_name():
+    from uvsym.derivation import observer_set
+    from uvsym.errors import UnknownNameError
+
+    with pytest.raises(UnknownNameError, match="unknown observer set 'sliding-mode'; known: .*actuator-observers"):
+        observer_set("sliding-mode")
+    with pytest.raises(UnknownNameError, match="takes no option --colour; its options: --vehicle, --form"):
+        observer_set("actuator-observers", colour="red")

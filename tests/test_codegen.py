@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from uvsym.codegen import find_compiler
-from uvsym.codegen.observer_sets import observer_set
-from uvsym.codegen.package import write_package
+from uvsym.codegen.package import Exported, casadi_name, write_package
+from uvsym.derivation import observer_set
 from uvsym.errors import CodegenError
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler (set $CC or install gcc)")
@@ -23,7 +23,8 @@ FLOAT_RTOL = 1e-5  # single precision: bound on max |c - python| / max(1, max |p
 
 @pytest.fixture(scope="module")
 def observers():
-    return observer_set("actuator-observers", vehicle_name="remus100", form="momentum")
+    made = observer_set("actuator-observers", vehicle="remus100", form="momentum")
+    return made.package_name, made.description, list(made.exported)
 
 
 @pytest.fixture(scope="module")
@@ -80,8 +81,8 @@ def _python(functions, records):
 def test_same_inputs_give_byte_identical_packages(tmp_path, observers):
     name, description, functions = observers
     write_package(tmp_path / "a", functions, name, "double", description)
-    again = observer_set("actuator-observers", vehicle_name="remus100", form="momentum")  # derived anew
-    write_package(tmp_path / "b", again[2], again[0], "double", again[1])
+    again = observer_set("actuator-observers", vehicle="remus100", form="momentum")  # derived anew
+    write_package(tmp_path / "b", list(again.exported), again.package_name, "double", again.description)
     files = sorted(p.relative_to(tmp_path / "a") for p in (tmp_path / "a").rglob("*") if p.is_file())
     assert len(files) == 9
     for relative in files:
@@ -143,7 +144,7 @@ def test_the_double_library_loads_through_casadi_external(tmp_path, package):
     shutil.copytree(source, work)
     subprocess.run(["make", f"lib{name}.so"], cwd=work, check=True, capture_output=True)
     combined = functions[-1].function
-    loaded = ca.external(combined.name(), str(work / f"lib{name}.so"))
+    loaded = ca.external(casadi_name(name, combined.name()), str(work / f"lib{name}.so"))
     rng = np.random.default_rng(0)
     args = [rng.normal(size=combined.nnz_in(i)) for i in range(combined.n_in())]
     for ours, theirs in zip(loaded(*args), combined(*args)):
@@ -177,3 +178,32 @@ def test_check_package_compiles_compares_and_names_a_broken_source(tmp_path, obs
     source.write_text(source.read_text() + "\nstatic int unused_and_warned;\n")
     with pytest.raises(CodegenError, match="does not compile cleanly"):
         check_package(tmp_path, functions, name, calls=3)
+
+
+def test_two_packages_with_the_same_function_name_link_into_one_program(tmp_path):
+    """Every external name carries the package's prefix: two packages that both export bias_step link together."""
+    x = ca.SX.sym("x", 2)
+    for package, expression in (("pkg_a", x + 1), ("pkg_b", 2 * ca.sin(x))):
+        function = ca.Function("bias_step", [x], [expression], ["x"], ["y"])
+        write_package(tmp_path / package, [Exported(function, ("x (-)",), ("y (-)",), "test")], package)
+    (tmp_path / "main.c").write_text("""#include <stdio.h>
+#include "pkg_a.h"
+#include "pkg_b.h"
+
+int main(void) {
+  pkg_a_real x[2] = {0.5, 1.0}, a[2];
+  pkg_b_real b[2];
+  if (pkg_a_bias_step(x, a) || pkg_b_bias_step(x, b)) return 1;
+  printf("%.17g %.17g %.17g %.17g\\n", a[0], a[1], b[0], b[1]);
+  return 0;
+}
+""")
+    sources = [str(tmp_path / p / "src" / f"{p}{suffix}.c") for p in ("pkg_a", "pkg_b") for suffix in ("_casadi", "")]
+    includes = [flag for p in ("pkg_a", "pkg_b") for flag in ("-I", str(tmp_path / p / "include"))]
+    exe = tmp_path / "both"
+    done = subprocess.run([find_compiler(), *STRICT, *includes, str(tmp_path / "main.c"), *sources, "-o", str(exe),
+                           "-lm"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    values = [float(v) for v in subprocess.run([str(exe)], capture_output=True, text=True).stdout.split()]
+    assert values == pytest.approx([1.5, 2.0, 2 * np.sin(0.5), 2 * np.sin(1.0)], rel=1e-15)
+

@@ -9,10 +9,10 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from derivations.actuator_observers.claims import core_paper_claims
 from uvsym.cli import main
 from uvsym.testing import assert_proved, assert_refuted
 from uvsym.verify import Certificate, exact_positive_definite, lyapunov_decrease, prove_identity
-from uvsym.verify.observers import core_paper_claims
 
 
 @pytest.fixture(scope="module")
@@ -122,9 +122,12 @@ def test_uvsym_verify_prints_json_writes_proofs_and_sets_the_exit_code(tmp_path,
     for row in rows:
         assert {"claim", "status", "expected", "method", "set", "margin", "seconds", "counterexample"} <= set(row)
     assert json.loads((tmp_path / "actuator-observers" / "proofs.json").read_text())[0]["claim"] == rows[0]["claim"]
+    from dataclasses import replace
+
     import derivations.actuator_observers as study
 
-    monkeypatch.setattr(study, "claims", lambda: [Certificate("wrong", "set", "method", "refuted")])
+    wrong = replace(study.DERIVATION, claims=lambda: [Certificate("wrong", "set", "method", "refuted")])
+    monkeypatch.setattr(study, "DERIVATION", wrong)
     assert main(["verify", "actuator-observers", "--out", str(tmp_path)]) == 1
 
 

@@ -1,4 +1,7 @@
-"""The ``uvsym`` command: list and inspect vehicles, build derivation reports."""
+"""The ``uvsym`` command: list and inspect vehicles, simulate, and run derivations (report, verify, codegen).
+
+Derivations and their observer sets come through :mod:`uvsym.derivation`.
+"""
 
 from __future__ import annotations
 
@@ -6,23 +9,16 @@ import argparse
 import json
 import os
 import sys
-from importlib.metadata import entry_points
 from pathlib import Path
 
 import numpy as np
 
 from uvsym import __version__
+from uvsym.derivation import Derivation, derivation, load_derivations, observer_set, observer_sets
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
 
-__all__ = ["main", "derivations"]
-
-DERIVATION_GROUP = "uvsym.derivations"
-
-
-def derivations() -> dict:
-    """Installed derivations: name -> entry point of a ``build(out_dir, progress)`` function."""
-    return {ep.name: ep for ep in sorted(entry_points(group=DERIVATION_GROUP), key=lambda ep: ep.name)}
+__all__ = ["main"]
 
 
 def _table(rows: list[list[str]], header: list[str]) -> str:
@@ -65,30 +61,24 @@ def _format_value(value) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in value) + "]" if isinstance(value, tuple) else f"{value:.6g}"
 
 
-def _selected_derivations(names: list[str]) -> tuple[dict, list[str]]:
-    """(installed derivations, the names asked for or all); UnknownNameError for a name not installed."""
-    available = derivations()
-    names = names or list(available)
-    unknown = [n for n in names if n not in available]
-    if unknown:
-        raise UnknownNameError(f"unknown derivation(s) {unknown}; known: {', '.join(available) or 'none installed'}")
-    return available, names
+def _selected(names: list[str]) -> list[Derivation]:
+    """The derivations named (each checked before any runs), or all installed ones."""
+    return [derivation(name) for name in names] if names else list(load_derivations().values())
 
 
 def _cmd_report(args) -> int:
     from uvsym.report.html import write_html
 
-    available, names = _selected_derivations(args.names)
+    selected = _selected(args.names)
     out_root = Path(args.out)
-    for index, name in enumerate(names, 1):
-        build = available[name].load()
-        out_dir = out_root / name
+    for index, study in enumerate(selected, 1):
+        out_dir = out_root / study.name
         out_dir.mkdir(parents=True, exist_ok=True)
 
-        def progress(message: str, _name=name, _index=index) -> None:
-            print(f"[{_index}/{len(names)}] {_name}: {message}", file=sys.stderr, flush=True)
+        def progress(message: str, _name=study.name, _index=index) -> None:
+            print(f"[{_index}/{len(selected)}] {_name}: {message}", file=sys.stderr, flush=True)
 
-        build(out_dir, progress)
+        study.build(out_dir, progress)
         progress("report.html")
         write_html(out_dir)
         print(f"wrote {out_dir}")
@@ -124,31 +114,34 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_codegen(args) -> int:
-    from uvsym.codegen.observer_sets import observer_set
-    from uvsym.codegen.package import write_package
+    from uvsym.codegen.observer_sets import option_flags, options_of
 
-    name, description, functions = observer_set(args.name, vehicle_name=args.vehicle, form=args.form)
-    manifest = write_package(args.out, functions, name, "float" if args.float else "double", description)
-    print(f"wrote {args.out}: {name}, {len(manifest['functions'])} functions "
+    if args.list or not args.name:
+        rows = [[name, study, option_flags(options_of(factory)), (factory.__doc__ or "").strip().split("\n")[0]]
+                for name, (study, factory) in observer_sets().items()]
+        print(_table(rows, ["observer set", "derivation", "options", "description"]))
+        return 0
+    if not args.out:
+        raise UvsymError(f"uvsym codegen {args.name}: give the output folder with -o/--out DIR")
+    options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
+    observers = observer_set(args.name, **options)
+    manifest = observers.write(args.out, "float" if args.float else "double")
+    print(f"wrote {args.out}: {observers.package_name}, {len(manifest['functions'])} functions "
           f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
           f"build with 'make' or cmake")
     return 0
 
 
 def _cmd_verify(args) -> int:
-    import importlib
     import time
 
     from uvsym.report.markdown import write_json
 
-    available, names = _selected_derivations(args.names)
     everything, failures = [], 0
-    for name in names:
-        module = importlib.import_module(available[name].module)
-        if not hasattr(module, "claims"):
-            continue
+    for study in (s for s in _selected(args.names) if s.claims is not None):
+        name = study.name
         started = time.perf_counter()
-        certificates = module.claims()
+        certificates = study.claims()
         rows = [c.to_dict() for c in certificates]
         failures += sum(not c.as_expected for c in certificates)
         out_dir = Path(args.out) / name
@@ -192,14 +185,12 @@ def _parser() -> argparse.ArgumentParser:
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
     simulate.set_defaults(run=_cmd_simulate)
-    from uvsym.codegen.observer_sets import OBSERVER_SETS
-    from uvsym.observers import FORMS
-
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest)")
-    codegen.add_argument("name", help=f"observer set: {', '.join(OBSERVER_SETS)}")
-    codegen.add_argument("-o", "--out", required=True, help="output folder")
-    codegen.add_argument("--vehicle", default="remus100", help="vehicle of the library (default remus100)")
-    codegen.add_argument("--form", choices=FORMS, default="momentum", help="observer form (default momentum)")
+    codegen.add_argument("name", nargs="?", help="observer set a derivation declares (none: list them)")
+    codegen.add_argument("-o", "--out", help="output folder (needed with a set)")
+    codegen.add_argument("--list", action="store_true", help="list the observer sets with their derivation")
+    codegen.add_argument("--vehicle", help="vehicle of the library, for a set that takes one (default: the set's)")
+    codegen.add_argument("--form", help="observer form, for a set that takes one (default: the set's)")
     codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi)")
     codegen.set_defaults(run=_cmd_codegen)
     verify = sub.add_parser("verify", help="check the derivations' claims by machine; exit 1 if any is unexpected")

@@ -17,7 +17,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.codegen.compile import find_compiler
-from uvsym.codegen.package import Exported
+from uvsym.codegen.package import Exported, casadi_name
 from uvsym.errors import CodegenError
 
 __all__ = ["STRICT_FLAGS", "PackageCheck", "check_package"]
@@ -56,7 +56,7 @@ def check_package(package_dir, functions: list[Exported], name: str, calls: int 
             raise CodegenError(f"the package does not compile cleanly: {' '.join(command)}\n{tail}")
         for exported in functions:
             python = exported.function
-            compiled = ca.external(python.name(), str(library))
+            compiled = ca.external(casadi_name(name, python.name()), str(library))
             for _ in range(calls):
                 args = [rng.normal(size=python.nnz_in(i)) for i in range(python.n_in())]
                 expected = np.concatenate([np.asarray(r, dtype=float).ravel() for r in python(*args)])

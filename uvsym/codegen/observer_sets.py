@@ -1,83 +1,59 @@
-"""Observer sets that ``uvsym codegen`` exports: which Functions, with which units.
+"""Observer sets: what ``uvsym codegen NAME`` exports, as a derivation declares it.
 
-``actuator-observers``: the core paper's proportional, bias and constant observers on a vehicle,
-each as its continuous right-hand side ``<kind>_observer(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``
-and as a discrete step ``<kind>_step(x, eta, nu, tau_d, K, dt) -> (x_next, f_hat)`` (one RK4 step
-of dt seconds with eta, nu and tau_d held), plus ``actuator_observers_step``, all three at once.
+A derivation maps set names to factories (:class:`uvsym.derivation.Derivation`); a factory takes
+keyword options only (e.g. ``vehicle``, ``form``), each with a default, and returns an
+:class:`ObserverSet`. :func:`make_observer_set` calls one with the options given and refuses an
+option the factory does not take.
 """
 
 from __future__ import annotations
 
-import casadi as ca
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass
 
-from uvsym.codegen.package import Exported
-from uvsym.errors import UnknownNameError
-from uvsym.models.registry import vehicle
-from uvsym.observers.actuator import KINDS, actuator_observer
-from uvsym.symbolic import rk4
+from uvsym.codegen.package import Exported, write_package
+from uvsym.errors import CodegenError, UnknownNameError
 
-__all__ = ["OBSERVER_SETS", "observer_set"]
-
-
-def _units(model, kind: str, form: str) -> tuple[str, str]:
-    """(unit of x and f_hat, unit of K) for an observer kind and form."""
-    force = ", ".join(model.force_units)
-    if kind == "proportional":
-        return "-", ("1/s per (desired force)^2, per channel" if form == "momentum" else "kg^2/(s (N or N m)^2)")
-    return force, ("1/s" if form == "momentum" else "kg^2/s, per channel (rate k/m^2)")
+__all__ = ["ObserverSet", "make_observer_set", "option_flags", "options_of"]
 
 
-def _step(function: ca.Function, name: str) -> ca.Function:
-    """One RK4 step of dt (run-time argument, s) of an observer with its other inputs held."""
-    n = function.size1_in("x")
-    x, eta, nu, tau_d, K, dt = (ca.SX.sym(v, size) for v, size in
-                                (("x", n), ("eta", n), ("nu", n), ("tau_d", n), ("K", n), ("dt", 1)))
-    x_next = rk4(lambda s, _t: function(s, eta, nu, tau_d, K)[0], x, dt, 1)
-    f_hat = function(x, eta, nu, tau_d, K)[1]
-    return ca.Function(name, [x, eta, nu, tau_d, K, dt], [x_next, f_hat],
-                       ["x", "eta", "nu", "tau_d", "K", "dt"], ["x_next", "f_hat"], {"cse": True})
+@dataclass(frozen=True)
+class ObserverSet:
+    """A C package's worth of Functions: its C name, a one-line description, what it exports."""
+
+    package_name: str
+    description: str
+    exported: tuple[Exported, ...]
+
+    def __post_init__(self):
+        if not self.exported or not all(isinstance(e, Exported) for e in self.exported):
+            raise CodegenError(f"observer set {self.package_name}: exported must be a non-empty tuple of Exported")
+
+    def write(self, out_dir, precision: str = "double") -> dict:
+        """Write the C package into ``out_dir`` (:func:`uvsym.codegen.package.write_package`); the manifest."""
+        return write_package(out_dir, list(self.exported), self.package_name, precision, self.description)
 
 
-def actuator_observers(vehicle_name: str = "remus100", form: str = "momentum"):
-    """(package name, description, [Exported]) for the three actuator observers of a vehicle."""
-    model = vehicle(vehicle_name)
-    pose = ", ".join(model.state_units[:model.dof])
-    velocity = ", ".join(model.state_units[model.dof:])
-    force = ", ".join(model.force_units)
-    exported, steps = [], []
-    for kind in KINDS:
-        observer = actuator_observer(model, kind, form).function
-        f_unit, k_unit = _units(model, kind, form)
-        inputs = (f"observer state ({f_unit})", f"eta ({pose})", f"nu ({velocity})", f"tau_d ({force})",
-                  f"K ({k_unit})")
-        exported.append(Exported(observer, inputs, (f"x_dot ({f_unit}/s)", f"f_hat ({f_unit})"),
-                                 f"{kind} observer of {model.name} ({form} form): continuous right-hand side"))
-        step = _step(observer, f"{kind}_step")
-        steps.append(step)
-        exported.append(Exported(step, (*inputs, "dt (s)"), (f"x_next ({f_unit})", f"f_hat ({f_unit})"),
-                                 f"{kind} observer of {model.name} ({form} form): one RK4 step of dt"))
-    n = model.dof
-    x, eta, nu, tau_d, K, dt = (ca.SX.sym(v, size) for v, size in
-                                (("x", 3 * n), ("eta", n), ("nu", n), ("tau_d", n), ("K", 3 * n), ("dt", 1)))
-    parts = [step(x[i * n:(i + 1) * n], eta, nu, tau_d, K[i * n:(i + 1) * n], dt) for i, step in enumerate(steps)]
-    combined = ca.Function("actuator_observers_step", [x, eta, nu, tau_d, K, dt],
-                           [ca.vertcat(*[p[0] for p in parts]), ca.vertcat(*[p[1] for p in parts])],
-                           ["x", "eta", "nu", "tau_d", "K", "dt"], ["x_next", "f_hat"], {"cse": True})
-    order = ", ".join(KINDS)
-    exported.append(Exported(combined, (f"states of the {order} observers, stacked", f"eta ({pose})",
-                                        f"nu ({velocity})", f"tau_d ({force})", f"K of the {order} observers, stacked",
-                                        "dt (s)"),
-                             (f"x_next, stacked ({order})", f"f_hat, stacked ({order})"),
-                             f"the {order} observers of {model.name} ({form} form): one RK4 step each"))
-    description = f"actuator-fault observers of the core paper (seeds/000) for {model.name}, {form} form"
-    return f"uvsym_{vehicle_name}_observers", description, exported
+def options_of(factory: Callable[..., ObserverSet]) -> tuple[str, ...]:
+    """The keyword options a factory takes."""
+    return tuple(name for name, p in inspect.signature(factory).parameters.items()
+                 if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD))
 
 
-OBSERVER_SETS = {"actuator-observers": actuator_observers}
+def option_flags(names) -> str:
+    """Options as the command line spells them: ``--vehicle, --form`` (``none`` for none)."""
+    return ", ".join("--" + name.replace("_", "-") for name in names) or "none"
 
 
-def observer_set(name: str, **options):
-    """The (package name, description, [Exported]) of a named observer set."""
-    if name not in OBSERVER_SETS:
-        raise UnknownNameError(f"unknown observer set {name!r}; known: {', '.join(OBSERVER_SETS)}")
-    return OBSERVER_SETS[name](**options)
+def make_observer_set(name: str, factory: Callable[..., ObserverSet], **options) -> ObserverSet:
+    """``factory(**options)`` of the set ``name``; UnknownNameError names an option it does not take."""
+    known = options_of(factory)
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise UnknownNameError(f"observer set {name!r} takes no option {option_flags(unknown)}; "
+                               f"its options: {option_flags(known)}")
+    made = factory(**options)
+    if not isinstance(made, ObserverSet):
+        raise CodegenError(f"observer set {name!r}: its factory returned {type(made).__name__}, not an ObserverSet")
+    return made

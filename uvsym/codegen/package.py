@@ -3,16 +3,20 @@
 ``write_package(out_dir, functions, name, precision)`` writes::
 
     include/<name>_casadi.h, src/<name>_casadi.c   CasADi's generated code (its standard API,
-                                                   so casadi.external can load the library)
+                                                   <name>_casadi_<function>, so casadi.external
+                                                   can load the library)
     include/<name>.h, src/<name>.c                 one documented wrapper per function:
-                                                   uvsym_<function>(inputs..., outputs...)
+                                                   <name>_<function>(inputs..., outputs...)
     main.c, harness.c                              an example program; a stdin/stdout harness
     Makefile, CMakeLists.txt                       static and shared library, example, harness
     manifest.json                                  functions, argument names, sizes, units,
                                                    precision, SHA-256 of each serialised Function
 
-Work buffers are static (sized by CasADi's ``*_SZ_*`` macros): nothing is allocated at run time,
-and the wrappers are not reentrant. The same functions and options give byte-identical files.
+Every external C name starts with the package name (CasADi's internals with ``<name>_casadi__``,
+the real type is ``<name>_real``), so that packages of the same precision link into one program
+and their headers go into one source file. Work buffers are static (sized by CasADi's ``*_SZ_*``
+macros): nothing is allocated at run time, and the wrappers are not reentrant. The same
+functions and options give byte-identical files.
 A double build matches the Python evaluation to 1e-12 relative; a float build (C only: it
 cannot be loaded through casadi.external) to 1e-5 of each call's largest output (tested).
 """
@@ -31,7 +35,7 @@ import casadi as ca
 
 from uvsym.errors import CodegenError
 
-__all__ = ["Exported", "PRECISIONS", "write_package"]
+__all__ = ["Exported", "PRECISIONS", "casadi_name", "write_package"]
 
 PRECISIONS = ("double", "float")
 
@@ -67,25 +71,36 @@ def _silence_unused(source: str) -> str:
 
 
 def _c_name(name: str) -> str:
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
-        raise CodegenError(f"{name!r} is not a C identifier")
+    if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name):
+        raise CodegenError(f"{name!r} is not a C identifier (a letter, then letters, digits and _)")
     return name
 
 
-def _wrapper(e: Exported) -> tuple[str, str]:
-    """(prototype with its documentation, definition) of uvsym_<name>."""
+def casadi_name(package: str, function: str) -> str:
+    """The name of ``function``'s CasADi API in ``package`` (what ``casadi.external`` loads)."""
+    return f"{package}_casadi_{function}"
+
+
+def _renamed(function: ca.Function, name: str) -> ca.Function:
+    """``function`` under another name: an SX graph is copied as it is, anything else is called."""
+    symbols = function.sx_in() if function.is_a("SXFunction") else function.mx_in()
+    return ca.Function(name, symbols, function.call(symbols), function.name_in(), function.name_out())
+
+
+def _wrapper(e: Exported, package: str) -> tuple[str, str]:
+    """(prototype with its documentation, definition) of <package>_<function>."""
     f = e.function
-    name = f.name()
-    args = [f"const uvsym_real {f.name_in(i)}[{f.nnz_in(i)}]" for i in range(f.n_in())]
-    args += [f"uvsym_real {f.name_out(i)}[{f.nnz_out(i)}]" for i in range(f.n_out())]
+    name, real = casadi_name(package, f.name()), f"{package}_real"
+    args = [f"const {real} {f.name_in(i)}[{f.nnz_in(i)}]" for i in range(f.n_in())]
+    args += [f"{real} {f.name_out(i)}[{f.nnz_out(i)}]" for i in range(f.n_out())]
     doc = [f"/* {e.description}", " *"]
     doc += [f" * in  {f.name_in(i)}[{f.nnz_in(i)}]: {e.input_units[i]}" for i in range(f.n_in())]
     doc += [f" * out {f.name_out(i)}[{f.nnz_out(i)}]: {e.output_units[i]}" for i in range(f.n_out())]
     doc += [" * Returns 0 on success. Uses static work buffers: not reentrant. */"]
-    prototype = "\n".join(doc) + f"\nint uvsym_{name}({', '.join(args)});\n"
+    prototype = "\n".join(doc) + f"\nint {package}_{f.name()}({', '.join(args)});\n"
     inputs = ", ".join(f.name_in(i) for i in range(f.n_in()))
     outputs = ", ".join(f.name_out(i) for i in range(f.n_out()))
-    body = f"""int uvsym_{name}({', '.join(args)}) {{
+    body = f"""int {package}_{f.name()}({', '.join(args)}) {{
   static casadi_int iw[{name}_SZ_IW > 0 ? {name}_SZ_IW : 1];
   static casadi_real w[{name}_SZ_W > 0 ? {name}_SZ_W : 1];
   const casadi_real* arg[{name}_SZ_ARG > 0 ? {name}_SZ_ARG : 1] = {{{inputs}}};
@@ -102,16 +117,16 @@ def _harness(functions: list[Exported], name: str) -> str:
     for index, e in enumerate(functions):
         f = e.function
         reads = "\n".join(f"      for (i = 0; i < {f.nnz_in(k)}; ++i) if (scanf(\"%lf\", &v) != 1) return 1; "
-                          f"else in{k}[i] = (uvsym_real)v;" for k in range(f.n_in()))
-        declare = " ".join(f"uvsym_real in{k}[{f.nnz_in(k)}];" for k in range(f.n_in()))
-        declare += " " + " ".join(f"uvsym_real out{k}[{f.nnz_out(k)}];" for k in range(f.n_out()))
+                          f"else in{k}[i] = ({name}_real)v;" for k in range(f.n_in()))
+        declare = " ".join(f"{name}_real in{k}[{f.nnz_in(k)}];" for k in range(f.n_in()))
+        declare += " " + " ".join(f"{name}_real out{k}[{f.nnz_out(k)}];" for k in range(f.n_out()))
         call = ", ".join([f"in{k}" for k in range(f.n_in())] + [f"out{k}" for k in range(f.n_out())])
         prints = "\n".join(f"      for (i = 0; i < {f.nnz_out(k)}; ++i) printf(\"%.17g \", (double)out{k}[i]);"
                            for k in range(f.n_out()))
         cases.append(f"""    case {index}: {{
       {declare}
 {reads}
-      if (uvsym_{f.name()}({call})) return 2;
+      if ({name}_{f.name()}({call})) return 2;
 {prints}
       break;
     }}""")
@@ -139,18 +154,18 @@ int main(void) {{
 
 def _example(functions: list[Exported], name: str) -> str:
     f = functions[-1].function
-    declare = "\n".join(f"  uvsym_real {f.name_in(i)}[{f.nnz_in(i)}] = {{0}};" for i in range(f.n_in()))
-    declare += "\n" + "\n".join(f"  uvsym_real {f.name_out(i)}[{f.nnz_out(i)}];" for i in range(f.n_out()))
+    declare = "\n".join(f"  {name}_real {f.name_in(i)}[{f.nnz_in(i)}] = {{0}};" for i in range(f.n_in()))
+    declare += "\n" + "\n".join(f"  {name}_real {f.name_out(i)}[{f.nnz_out(i)}];" for i in range(f.n_out()))
     call = ", ".join([f.name_in(i) for i in range(f.n_in())] + [f.name_out(i) for i in range(f.n_out())])
     last = f.name_out(f.n_out() - 1)
-    return f"""/* Example: one call of uvsym_{f.name()} with zero inputs; prints its last output. */
+    return f"""/* Example: one call of {name}_{f.name()} with zero inputs; prints its last output. */
 #include <stdio.h>
 #include "{name}.h"
 
 int main(void) {{
   int i;
 {declare}
-  if (uvsym_{f.name()}({call})) return 1;
+  if ({name}_{f.name()}({call})) return 1;
   for (i = 0; i < {f.nnz_out(f.n_out() - 1)}; ++i) printf("%g ", (double){last}[i]);
   printf("\\n");
   return 0;
@@ -219,23 +234,28 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     if precision not in PRECISIONS:
         raise CodegenError(f"unknown precision {precision!r}; known: {', '.join(PRECISIONS)}")
     name = _c_name(name)
+    names = [_c_name(e.function.name()) for e in functions]
+    if len(set(names)) < len(names):
+        raise CodegenError(f"package {name}: function names must differ; given {', '.join(names)}")
     out = Path(out_dir)
     (out / "include").mkdir(parents=True, exist_ok=True)
     (out / "src").mkdir(exist_ok=True)
-    generator = ca.CodeGenerator(f"{name}_casadi", {"with_header": True, "casadi_real": precision})
+    # CasADi's internal symbols get the prefix <name>_casadi__, so they cannot meet an API name
+    generator = ca.CodeGenerator(f"{name}_casadi", {"with_header": True, "casadi_real": precision,
+                                                    "prefix": f"{name}_casadi_"})
     for e in functions:
-        generator.add(e.function)
+        generator.add(_renamed(e.function, casadi_name(name, e.function.name())))
     with tempfile.TemporaryDirectory() as scratch:
         generator.generate(f"{scratch}{os.sep}")
         source = _silence_unused((Path(scratch) / f"{name}_casadi.c").read_text())
         header = (Path(scratch) / f"{name}_casadi.h").read_text()
     (out / "src" / f"{name}_casadi.c").write_text(source)
     (out / "include" / f"{name}_casadi.h").write_text(header)
-    wrappers = [_wrapper(e) for e in functions]
+    wrappers = [_wrapper(e, name) for e in functions]
     guard = name.upper() + "_H"
     (out / "include" / f"{name}.h").write_text(
         f"/* {description or name}: wrapper API generated by uvsym. Precision: {precision}. */\n"
-        f"#ifndef {guard}\n#define {guard}\n#include \"{name}_casadi.h\"\n\ntypedef casadi_real uvsym_real;\n\n"
+        f"#ifndef {guard}\n#define {guard}\n#include \"{name}_casadi.h\"\n\ntypedef casadi_real {name}_real;\n\n"
         + "\n".join(p for p, _ in wrappers) + f"\n#endif /* {guard} */\n")
     (out / "src" / f"{name}.c").write_text(f'#include "{name}.h"\n\n' + "\n".join(b for _, b in wrappers))
     (out / "main.c").write_text(_example(functions, name))
@@ -245,7 +265,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     manifest = {
         "package": name, "description": description, "precision": precision, "casadi": ca.__version__,
         "functions": [{
-            "name": e.function.name(), "c_function": f"uvsym_{e.function.name()}", "description": e.description,
+            "name": e.function.name(), "c_function": f"{name}_{e.function.name()}",
+            "casadi_function": casadi_name(name, e.function.name()), "description": e.description,
             "inputs": [{"name": e.function.name_in(i), "size": e.function.nnz_in(i), "unit": e.input_units[i]}
                        for i in range(e.function.n_in())],
             "outputs": [{"name": e.function.name_out(i), "size": e.function.nnz_out(i), "unit": e.output_units[i]}

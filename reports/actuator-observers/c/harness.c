@@ -10,89 +10,89 @@ int main(void) {
   while (scanf("%d", &index) == 1) {
     switch (index) {
     case 0: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      if (uvsym_proportional_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_proportional_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 1: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real in5[1]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_real)v;
-      if (uvsym_proportional_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real in5[1]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_proportional_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 2: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      if (uvsym_bias_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_bias_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 3: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real in5[1]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_real)v;
-      if (uvsym_bias_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real in5[1]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_bias_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 4: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      if (uvsym_constant_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_constant_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 5: {
-      uvsym_real in0[6]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[6]; uvsym_real in5[1]; uvsym_real out0[6]; uvsym_real out1[6];
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_real)v;
-      if (uvsym_constant_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[6]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[6]; uvsym_docking_auv_observers_real in5[1]; uvsym_docking_auv_observers_real out0[6]; uvsym_docking_auv_observers_real out1[6];
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_constant_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
       break;
     }
     case 6: {
-      uvsym_real in0[18]; uvsym_real in1[6]; uvsym_real in2[6]; uvsym_real in3[6]; uvsym_real in4[18]; uvsym_real in5[1]; uvsym_real out0[18]; uvsym_real out1[18];
-      for (i = 0; i < 18; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_real)v;
-      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_real)v;
-      for (i = 0; i < 18; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_real)v;
-      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_real)v;
-      if (uvsym_actuator_observers_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
+      uvsym_docking_auv_observers_real in0[18]; uvsym_docking_auv_observers_real in1[6]; uvsym_docking_auv_observers_real in2[6]; uvsym_docking_auv_observers_real in3[6]; uvsym_docking_auv_observers_real in4[18]; uvsym_docking_auv_observers_real in5[1]; uvsym_docking_auv_observers_real out0[18]; uvsym_docking_auv_observers_real out1[18];
+      for (i = 0; i < 18; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 18; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
+      if (uvsym_docking_auv_observers_actuator_observers_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
       for (i = 0; i < 18; ++i) printf("%.17g ", (double)out0[i]);
       for (i = 0; i < 18; ++i) printf("%.17g ", (double)out1[i]);
       break;

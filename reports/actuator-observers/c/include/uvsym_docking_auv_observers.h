@@ -3,7 +3,7 @@
 #define UVSYM_DOCKING_AUV_OBSERVERS_H
 #include "uvsym_docking_auv_observers_casadi.h"
 
-typedef casadi_real uvsym_real;
+typedef casadi_real uvsym_docking_auv_observers_real;
 
 /* proportional observer of docking_auv (momentum form): continuous right-hand side
  *
@@ -15,7 +15,7 @@ typedef casadi_real uvsym_real;
  * out x_dot[6]: x_dot (-/s)
  * out f_hat[6]: f_hat (-)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_proportional_observer(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], uvsym_real x_dot[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_proportional_observer(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], uvsym_docking_auv_observers_real x_dot[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* proportional observer of docking_auv (momentum form): one RK4 step of dt
  *
@@ -28,7 +28,7 @@ int uvsym_proportional_observer(const uvsym_real x[6], const uvsym_real eta[6], 
  * out x_next[6]: x_next (-)
  * out f_hat[6]: f_hat (-)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_proportional_step(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], const uvsym_real dt[1], uvsym_real x_next[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_proportional_step(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], const uvsym_docking_auv_observers_real dt[1], uvsym_docking_auv_observers_real x_next[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* bias observer of docking_auv (momentum form): continuous right-hand side
  *
@@ -40,7 +40,7 @@ int uvsym_proportional_step(const uvsym_real x[6], const uvsym_real eta[6], cons
  * out x_dot[6]: x_dot (N, N, N, N m, N m, N m/s)
  * out f_hat[6]: f_hat (N, N, N, N m, N m, N m)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_bias_observer(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], uvsym_real x_dot[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_bias_observer(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], uvsym_docking_auv_observers_real x_dot[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* bias observer of docking_auv (momentum form): one RK4 step of dt
  *
@@ -53,7 +53,7 @@ int uvsym_bias_observer(const uvsym_real x[6], const uvsym_real eta[6], const uv
  * out x_next[6]: x_next (N, N, N, N m, N m, N m)
  * out f_hat[6]: f_hat (N, N, N, N m, N m, N m)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_bias_step(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], const uvsym_real dt[1], uvsym_real x_next[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_bias_step(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], const uvsym_docking_auv_observers_real dt[1], uvsym_docking_auv_observers_real x_next[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* constant observer of docking_auv (momentum form): continuous right-hand side
  *
@@ -65,7 +65,7 @@ int uvsym_bias_step(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_
  * out x_dot[6]: x_dot (N, N, N, N m, N m, N m/s)
  * out f_hat[6]: f_hat (N, N, N, N m, N m, N m)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_constant_observer(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], uvsym_real x_dot[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_constant_observer(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], uvsym_docking_auv_observers_real x_dot[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* constant observer of docking_auv (momentum form): one RK4 step of dt
  *
@@ -78,7 +78,7 @@ int uvsym_constant_observer(const uvsym_real x[6], const uvsym_real eta[6], cons
  * out x_next[6]: x_next (N, N, N, N m, N m, N m)
  * out f_hat[6]: f_hat (N, N, N, N m, N m, N m)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_constant_step(const uvsym_real x[6], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[6], const uvsym_real dt[1], uvsym_real x_next[6], uvsym_real f_hat[6]);
+int uvsym_docking_auv_observers_constant_step(const uvsym_docking_auv_observers_real x[6], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[6], const uvsym_docking_auv_observers_real dt[1], uvsym_docking_auv_observers_real x_next[6], uvsym_docking_auv_observers_real f_hat[6]);
 
 /* the proportional, bias, constant observers of docking_auv (momentum form): one RK4 step each
  *
@@ -91,6 +91,6 @@ int uvsym_constant_step(const uvsym_real x[6], const uvsym_real eta[6], const uv
  * out x_next[18]: x_next, stacked (proportional, bias, constant)
  * out f_hat[18]: f_hat, stacked (proportional, bias, constant)
  * Returns 0 on success. Uses static work buffers: not reentrant. */
-int uvsym_actuator_observers_step(const uvsym_real x[18], const uvsym_real eta[6], const uvsym_real nu[6], const uvsym_real tau_d[6], const uvsym_real K[18], const uvsym_real dt[1], uvsym_real x_next[18], uvsym_real f_hat[18]);
+int uvsym_docking_auv_observers_actuator_observers_step(const uvsym_docking_auv_observers_real x[18], const uvsym_docking_auv_observers_real eta[6], const uvsym_docking_auv_observers_real nu[6], const uvsym_docking_auv_observers_real tau_d[6], const uvsym_docking_auv_observers_real K[18], const uvsym_docking_auv_observers_real dt[1], uvsym_docking_auv_observers_real x_next[18], uvsym_docking_auv_observers_real f_hat[18]);
 
 #endif /* UVSYM_DOCKING_AUV_OBSERVERS_H */

@@ -17,135 +17,135 @@ extern "C" {
 #define casadi_int long long int
 #endif
 
-int proportional_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int proportional_observer_checkout(void);
-void proportional_observer_release(int mem);
-void proportional_observer_incref(void);
-void proportional_observer_decref(void);
-casadi_int proportional_observer_n_in(void);
-casadi_int proportional_observer_n_out(void);
-casadi_real proportional_observer_default_in(casadi_int i);
-const char* proportional_observer_name_in(casadi_int i);
-const char* proportional_observer_name_out(casadi_int i);
-const casadi_int* proportional_observer_sparsity_in(casadi_int i);
-const casadi_int* proportional_observer_sparsity_out(casadi_int i);
-int proportional_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int proportional_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define proportional_observer_SZ_ARG 5
-#define proportional_observer_SZ_RES 2
-#define proportional_observer_SZ_IW 0
-#define proportional_observer_SZ_W 0
-int proportional_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int proportional_step_checkout(void);
-void proportional_step_release(int mem);
-void proportional_step_incref(void);
-void proportional_step_decref(void);
-casadi_int proportional_step_n_in(void);
-casadi_int proportional_step_n_out(void);
-casadi_real proportional_step_default_in(casadi_int i);
-const char* proportional_step_name_in(casadi_int i);
-const char* proportional_step_name_out(casadi_int i);
-const casadi_int* proportional_step_sparsity_in(casadi_int i);
-const casadi_int* proportional_step_sparsity_out(casadi_int i);
-int proportional_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int proportional_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define proportional_step_SZ_ARG 6
-#define proportional_step_SZ_RES 2
-#define proportional_step_SZ_IW 0
-#define proportional_step_SZ_W 0
-int bias_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int bias_observer_checkout(void);
-void bias_observer_release(int mem);
-void bias_observer_incref(void);
-void bias_observer_decref(void);
-casadi_int bias_observer_n_in(void);
-casadi_int bias_observer_n_out(void);
-casadi_real bias_observer_default_in(casadi_int i);
-const char* bias_observer_name_in(casadi_int i);
-const char* bias_observer_name_out(casadi_int i);
-const casadi_int* bias_observer_sparsity_in(casadi_int i);
-const casadi_int* bias_observer_sparsity_out(casadi_int i);
-int bias_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int bias_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define bias_observer_SZ_ARG 5
-#define bias_observer_SZ_RES 2
-#define bias_observer_SZ_IW 0
-#define bias_observer_SZ_W 0
-int bias_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int bias_step_checkout(void);
-void bias_step_release(int mem);
-void bias_step_incref(void);
-void bias_step_decref(void);
-casadi_int bias_step_n_in(void);
-casadi_int bias_step_n_out(void);
-casadi_real bias_step_default_in(casadi_int i);
-const char* bias_step_name_in(casadi_int i);
-const char* bias_step_name_out(casadi_int i);
-const casadi_int* bias_step_sparsity_in(casadi_int i);
-const casadi_int* bias_step_sparsity_out(casadi_int i);
-int bias_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int bias_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define bias_step_SZ_ARG 6
-#define bias_step_SZ_RES 2
-#define bias_step_SZ_IW 0
-#define bias_step_SZ_W 0
-int constant_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int constant_observer_checkout(void);
-void constant_observer_release(int mem);
-void constant_observer_incref(void);
-void constant_observer_decref(void);
-casadi_int constant_observer_n_in(void);
-casadi_int constant_observer_n_out(void);
-casadi_real constant_observer_default_in(casadi_int i);
-const char* constant_observer_name_in(casadi_int i);
-const char* constant_observer_name_out(casadi_int i);
-const casadi_int* constant_observer_sparsity_in(casadi_int i);
-const casadi_int* constant_observer_sparsity_out(casadi_int i);
-int constant_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int constant_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define constant_observer_SZ_ARG 5
-#define constant_observer_SZ_RES 2
-#define constant_observer_SZ_IW 0
-#define constant_observer_SZ_W 0
-int constant_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int constant_step_checkout(void);
-void constant_step_release(int mem);
-void constant_step_incref(void);
-void constant_step_decref(void);
-casadi_int constant_step_n_in(void);
-casadi_int constant_step_n_out(void);
-casadi_real constant_step_default_in(casadi_int i);
-const char* constant_step_name_in(casadi_int i);
-const char* constant_step_name_out(casadi_int i);
-const casadi_int* constant_step_sparsity_in(casadi_int i);
-const casadi_int* constant_step_sparsity_out(casadi_int i);
-int constant_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int constant_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define constant_step_SZ_ARG 6
-#define constant_step_SZ_RES 2
-#define constant_step_SZ_IW 0
-#define constant_step_SZ_W 0
-int actuator_observers_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int actuator_observers_step_checkout(void);
-void actuator_observers_step_release(int mem);
-void actuator_observers_step_incref(void);
-void actuator_observers_step_decref(void);
-casadi_int actuator_observers_step_n_in(void);
-casadi_int actuator_observers_step_n_out(void);
-casadi_real actuator_observers_step_default_in(casadi_int i);
-const char* actuator_observers_step_name_in(casadi_int i);
-const char* actuator_observers_step_name_out(casadi_int i);
-const casadi_int* actuator_observers_step_sparsity_in(casadi_int i);
-const casadi_int* actuator_observers_step_sparsity_out(casadi_int i);
-int actuator_observers_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int actuator_observers_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define actuator_observers_step_SZ_ARG 6
-#define actuator_observers_step_SZ_RES 2
-#define actuator_observers_step_SZ_IW 0
-#define actuator_observers_step_SZ_W 0
-void uvsym_docking_auv_observers_casadi_casadi_version(int* major, int* minor, int* patch);
-int uvsym_docking_auv_observers_casadi_casadi_int_size(void);
-int uvsym_docking_auv_observers_casadi_casadi_real_size(void);
+int uvsym_docking_auv_observers_casadi_proportional_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_proportional_observer_checkout(void);
+void uvsym_docking_auv_observers_casadi_proportional_observer_release(int mem);
+void uvsym_docking_auv_observers_casadi_proportional_observer_incref(void);
+void uvsym_docking_auv_observers_casadi_proportional_observer_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_proportional_observer_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_proportional_observer_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_proportional_observer_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_proportional_observer_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_proportional_observer_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_proportional_observer_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_proportional_observer_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_proportional_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_proportional_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_proportional_observer_SZ_ARG 5
+#define uvsym_docking_auv_observers_casadi_proportional_observer_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_proportional_observer_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_proportional_observer_SZ_W 0
+int uvsym_docking_auv_observers_casadi_proportional_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_proportional_step_checkout(void);
+void uvsym_docking_auv_observers_casadi_proportional_step_release(int mem);
+void uvsym_docking_auv_observers_casadi_proportional_step_incref(void);
+void uvsym_docking_auv_observers_casadi_proportional_step_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_proportional_step_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_proportional_step_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_proportional_step_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_proportional_step_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_proportional_step_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_proportional_step_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_proportional_step_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_proportional_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_proportional_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_proportional_step_SZ_ARG 6
+#define uvsym_docking_auv_observers_casadi_proportional_step_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_proportional_step_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_proportional_step_SZ_W 0
+int uvsym_docking_auv_observers_casadi_bias_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_bias_observer_checkout(void);
+void uvsym_docking_auv_observers_casadi_bias_observer_release(int mem);
+void uvsym_docking_auv_observers_casadi_bias_observer_incref(void);
+void uvsym_docking_auv_observers_casadi_bias_observer_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_bias_observer_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_bias_observer_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_bias_observer_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_bias_observer_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_bias_observer_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_bias_observer_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_bias_observer_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_bias_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_bias_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_bias_observer_SZ_ARG 5
+#define uvsym_docking_auv_observers_casadi_bias_observer_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_bias_observer_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_bias_observer_SZ_W 0
+int uvsym_docking_auv_observers_casadi_bias_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_bias_step_checkout(void);
+void uvsym_docking_auv_observers_casadi_bias_step_release(int mem);
+void uvsym_docking_auv_observers_casadi_bias_step_incref(void);
+void uvsym_docking_auv_observers_casadi_bias_step_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_bias_step_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_bias_step_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_bias_step_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_bias_step_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_bias_step_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_bias_step_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_bias_step_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_bias_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_bias_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_bias_step_SZ_ARG 6
+#define uvsym_docking_auv_observers_casadi_bias_step_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_bias_step_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_bias_step_SZ_W 0
+int uvsym_docking_auv_observers_casadi_constant_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_constant_observer_checkout(void);
+void uvsym_docking_auv_observers_casadi_constant_observer_release(int mem);
+void uvsym_docking_auv_observers_casadi_constant_observer_incref(void);
+void uvsym_docking_auv_observers_casadi_constant_observer_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_constant_observer_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_constant_observer_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_constant_observer_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_constant_observer_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_constant_observer_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_constant_observer_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_constant_observer_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_constant_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_constant_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_constant_observer_SZ_ARG 5
+#define uvsym_docking_auv_observers_casadi_constant_observer_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_constant_observer_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_constant_observer_SZ_W 0
+int uvsym_docking_auv_observers_casadi_constant_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_constant_step_checkout(void);
+void uvsym_docking_auv_observers_casadi_constant_step_release(int mem);
+void uvsym_docking_auv_observers_casadi_constant_step_incref(void);
+void uvsym_docking_auv_observers_casadi_constant_step_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_constant_step_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_constant_step_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_constant_step_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_constant_step_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_constant_step_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_constant_step_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_constant_step_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_constant_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_constant_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_constant_step_SZ_ARG 6
+#define uvsym_docking_auv_observers_casadi_constant_step_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_constant_step_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_constant_step_SZ_W 0
+int uvsym_docking_auv_observers_casadi_actuator_observers_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_docking_auv_observers_casadi_actuator_observers_step_checkout(void);
+void uvsym_docking_auv_observers_casadi_actuator_observers_step_release(int mem);
+void uvsym_docking_auv_observers_casadi_actuator_observers_step_incref(void);
+void uvsym_docking_auv_observers_casadi_actuator_observers_step_decref(void);
+casadi_int uvsym_docking_auv_observers_casadi_actuator_observers_step_n_in(void);
+casadi_int uvsym_docking_auv_observers_casadi_actuator_observers_step_n_out(void);
+casadi_real uvsym_docking_auv_observers_casadi_actuator_observers_step_default_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_actuator_observers_step_name_in(casadi_int i);
+const char* uvsym_docking_auv_observers_casadi_actuator_observers_step_name_out(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_actuator_observers_step_sparsity_in(casadi_int i);
+const casadi_int* uvsym_docking_auv_observers_casadi_actuator_observers_step_sparsity_out(casadi_int i);
+int uvsym_docking_auv_observers_casadi_actuator_observers_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_docking_auv_observers_casadi_actuator_observers_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_docking_auv_observers_casadi_actuator_observers_step_SZ_ARG 6
+#define uvsym_docking_auv_observers_casadi_actuator_observers_step_SZ_RES 2
+#define uvsym_docking_auv_observers_casadi_actuator_observers_step_SZ_IW 0
+#define uvsym_docking_auv_observers_casadi_actuator_observers_step_SZ_W 0
+void uvsym_docking_auv_observers_casadi__casadi_version(int* major, int* minor, int* patch);
+int uvsym_docking_auv_observers_casadi__casadi_int_size(void);
+int uvsym_docking_auv_observers_casadi__casadi_real_size(void);
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -15,7 +15,7 @@ extern "C" {
   #define _CASADI_NAMESPACE_CONCAT(NS, ID) NS ## ID
   #define CASADI_PREFIX(ID) CASADI_NAMESPACE_CONCAT(CODEGEN_PREFIX, ID)
 #else
-  #define CASADI_PREFIX(ID) uvsym_docking_auv_observers_casadi_ ## ID
+  #define CASADI_PREFIX(ID) uvsym_docking_auv_observers_casadi__ ## ID
 #endif
 
 #include <math.h>
@@ -79,19 +79,19 @@ casadi_real casadi_fmin(casadi_real x, casadi_real y) {
 }
 
 /* Configuration this file was compiled with */
-CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_casadi_version(int* major, int* minor, int* patch) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi__casadi_version(int* major, int* minor, int* patch) {
   *major = 3;
   *minor = 8;
   *patch = 2;
 }
-CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_casadi_int_size(void) { return (int) sizeof(casadi_int); }
-CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_casadi_real_size(void) { return (int) sizeof(casadi_real); }
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi__casadi_int_size(void) { return (int) sizeof(casadi_int); }
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi__casadi_real_size(void) { return (int) sizeof(casadi_real); }
 
 static const casadi_int casadi_s0[3] = {6, 1, 1};
 static const casadi_int casadi_s1[3] = {1, 1, 1};
 static const casadi_int casadi_s2[3] = {18, 1, 1};
 
-/* proportional_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_proportional_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -524,36 +524,36 @@ static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int proportional_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f0(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int proportional_observer_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_observer_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void proportional_observer_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_observer_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void proportional_observer_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_observer_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void proportional_observer_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_observer_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int proportional_observer_n_in(void) { return 5;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_proportional_observer_n_in(void) { return 5;}
 
-CASADI_SYMBOL_EXPORT casadi_int proportional_observer_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_proportional_observer_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real proportional_observer_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_proportional_observer_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* proportional_observer_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_proportional_observer_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -564,7 +564,7 @@ CASADI_SYMBOL_EXPORT const char* proportional_observer_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* proportional_observer_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_proportional_observer_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_dot";
     case 1: return "f_hat";
@@ -572,7 +572,7 @@ CASADI_SYMBOL_EXPORT const char* proportional_observer_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* proportional_observer_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_proportional_observer_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -583,7 +583,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* proportional_observer_sparsity_in(casadi_
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* proportional_observer_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_proportional_observer_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -591,7 +591,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* proportional_observer_sparsity_out(casadi
   }
 }
 
-CASADI_SYMBOL_EXPORT int proportional_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -599,7 +599,7 @@ CASADI_SYMBOL_EXPORT int proportional_observer_work(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int proportional_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -607,7 +607,7 @@ CASADI_SYMBOL_EXPORT int proportional_observer_work_bytes(casadi_int *sz_arg, ca
   return 0;
 }
 
-/* proportional_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_proportional_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
 static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -1188,36 +1188,36 @@ static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int proportional_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f1(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int proportional_step_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_step_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void proportional_step_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_step_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void proportional_step_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_step_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void proportional_step_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_proportional_step_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int proportional_step_n_in(void) { return 6;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_proportional_step_n_in(void) { return 6;}
 
-CASADI_SYMBOL_EXPORT casadi_int proportional_step_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_proportional_step_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real proportional_step_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_proportional_step_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* proportional_step_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_proportional_step_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -1229,7 +1229,7 @@ CASADI_SYMBOL_EXPORT const char* proportional_step_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* proportional_step_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_proportional_step_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_next";
     case 1: return "f_hat";
@@ -1237,7 +1237,7 @@ CASADI_SYMBOL_EXPORT const char* proportional_step_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* proportional_step_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_proportional_step_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -1249,7 +1249,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* proportional_step_sparsity_in(casadi_int 
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* proportional_step_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_proportional_step_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -1257,7 +1257,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* proportional_step_sparsity_out(casadi_int
   }
 }
 
-CASADI_SYMBOL_EXPORT int proportional_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -1265,7 +1265,7 @@ CASADI_SYMBOL_EXPORT int proportional_step_work(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int proportional_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_proportional_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -1273,7 +1273,7 @@ CASADI_SYMBOL_EXPORT int proportional_step_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* bias_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_bias_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
 static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -1665,36 +1665,36 @@ static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int bias_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f2(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int bias_observer_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_observer_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void bias_observer_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_observer_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void bias_observer_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_observer_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void bias_observer_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_observer_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int bias_observer_n_in(void) { return 5;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_bias_observer_n_in(void) { return 5;}
 
-CASADI_SYMBOL_EXPORT casadi_int bias_observer_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_bias_observer_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real bias_observer_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_bias_observer_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* bias_observer_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_bias_observer_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -1705,7 +1705,7 @@ CASADI_SYMBOL_EXPORT const char* bias_observer_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* bias_observer_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_bias_observer_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_dot";
     case 1: return "f_hat";
@@ -1713,7 +1713,7 @@ CASADI_SYMBOL_EXPORT const char* bias_observer_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* bias_observer_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_bias_observer_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -1724,7 +1724,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* bias_observer_sparsity_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* bias_observer_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_bias_observer_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -1732,7 +1732,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* bias_observer_sparsity_out(casadi_int i) 
   }
 }
 
-CASADI_SYMBOL_EXPORT int bias_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -1740,7 +1740,7 @@ CASADI_SYMBOL_EXPORT int bias_observer_work(casadi_int *sz_arg, casadi_int* sz_r
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int bias_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -1748,7 +1748,7 @@ CASADI_SYMBOL_EXPORT int bias_observer_work_bytes(casadi_int *sz_arg, casadi_int
   return 0;
 }
 
-/* bias_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_bias_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -2278,36 +2278,36 @@ static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int bias_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f3(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int bias_step_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_step_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void bias_step_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_step_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void bias_step_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_step_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void bias_step_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_bias_step_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int bias_step_n_in(void) { return 6;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_bias_step_n_in(void) { return 6;}
 
-CASADI_SYMBOL_EXPORT casadi_int bias_step_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_bias_step_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real bias_step_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_bias_step_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* bias_step_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_bias_step_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -2319,7 +2319,7 @@ CASADI_SYMBOL_EXPORT const char* bias_step_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* bias_step_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_bias_step_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_next";
     case 1: return "f_hat";
@@ -2327,7 +2327,7 @@ CASADI_SYMBOL_EXPORT const char* bias_step_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* bias_step_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_bias_step_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -2339,7 +2339,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* bias_step_sparsity_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* bias_step_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_bias_step_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -2347,7 +2347,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* bias_step_sparsity_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT int bias_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -2355,7 +2355,7 @@ CASADI_SYMBOL_EXPORT int bias_step_work(casadi_int *sz_arg, casadi_int* sz_res, 
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int bias_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_bias_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -2363,7 +2363,7 @@ CASADI_SYMBOL_EXPORT int bias_step_work_bytes(casadi_int *sz_arg, casadi_int* sz
   return 0;
 }
 
-/* constant_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_constant_observer:(x[6],eta[6],nu[6],tau_d[6],K[6])->(x_dot[6],f_hat[6]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -2743,36 +2743,36 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int constant_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_observer(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f4(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int constant_observer_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_observer_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void constant_observer_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_observer_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void constant_observer_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_observer_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void constant_observer_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_observer_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int constant_observer_n_in(void) { return 5;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_constant_observer_n_in(void) { return 5;}
 
-CASADI_SYMBOL_EXPORT casadi_int constant_observer_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_constant_observer_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real constant_observer_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_constant_observer_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* constant_observer_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_constant_observer_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -2783,7 +2783,7 @@ CASADI_SYMBOL_EXPORT const char* constant_observer_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* constant_observer_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_constant_observer_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_dot";
     case 1: return "f_hat";
@@ -2791,7 +2791,7 @@ CASADI_SYMBOL_EXPORT const char* constant_observer_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* constant_observer_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_constant_observer_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -2802,7 +2802,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* constant_observer_sparsity_in(casadi_int 
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* constant_observer_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_constant_observer_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -2810,7 +2810,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* constant_observer_sparsity_out(casadi_int
   }
 }
 
-CASADI_SYMBOL_EXPORT int constant_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_observer_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -2818,7 +2818,7 @@ CASADI_SYMBOL_EXPORT int constant_observer_work(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int constant_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_observer_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 5*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -2826,7 +2826,7 @@ CASADI_SYMBOL_EXPORT int constant_observer_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* constant_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
+/* uvsym_docking_auv_observers_casadi_constant_step:(x[6],eta[6],nu[6],tau_d[6],K[6],dt)->(x_next[6],f_hat[6]) */
 static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -3325,36 +3325,36 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int constant_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f5(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int constant_step_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_step_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void constant_step_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_step_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void constant_step_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_step_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void constant_step_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_constant_step_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int constant_step_n_in(void) { return 6;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_constant_step_n_in(void) { return 6;}
 
-CASADI_SYMBOL_EXPORT casadi_int constant_step_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_constant_step_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real constant_step_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_constant_step_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* constant_step_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_constant_step_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -3366,7 +3366,7 @@ CASADI_SYMBOL_EXPORT const char* constant_step_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* constant_step_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_constant_step_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_next";
     case 1: return "f_hat";
@@ -3374,7 +3374,7 @@ CASADI_SYMBOL_EXPORT const char* constant_step_name_out(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* constant_step_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_constant_step_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -3386,7 +3386,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* constant_step_sparsity_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* constant_step_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_constant_step_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s0;
     case 1: return casadi_s0;
@@ -3394,7 +3394,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* constant_step_sparsity_out(casadi_int i) 
   }
 }
 
-CASADI_SYMBOL_EXPORT int constant_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -3402,7 +3402,7 @@ CASADI_SYMBOL_EXPORT int constant_step_work(casadi_int *sz_arg, casadi_int* sz_r
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int constant_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_constant_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
@@ -3410,7 +3410,7 @@ CASADI_SYMBOL_EXPORT int constant_step_work_bytes(casadi_int *sz_arg, casadi_int
   return 0;
 }
 
-/* actuator_observers_step:(x[18],eta[6],nu[6],tau_d[6],K[18],dt)->(x_next[18],f_hat[18]) */
+/* uvsym_docking_auv_observers_casadi_actuator_observers_step:(x[18],eta[6],nu[6],tau_d[6],K[18],dt)->(x_next[18],f_hat[18]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -4505,36 +4505,36 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int actuator_observers_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_actuator_observers_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
   (void)iw; (void)w; (void)mem;
   return casadi_f6(arg, res, iw, w, mem);
 }
 
-CASADI_SYMBOL_EXPORT int actuator_observers_step_checkout(void) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_actuator_observers_step_checkout(void) {
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT void actuator_observers_step_release(int mem) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_actuator_observers_step_release(int mem) {
   (void)mem;
 }
 
-CASADI_SYMBOL_EXPORT void actuator_observers_step_incref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_actuator_observers_step_incref(void) {
 }
 
-CASADI_SYMBOL_EXPORT void actuator_observers_step_decref(void) {
+CASADI_SYMBOL_EXPORT void uvsym_docking_auv_observers_casadi_actuator_observers_step_decref(void) {
 }
 
-CASADI_SYMBOL_EXPORT casadi_int actuator_observers_step_n_in(void) { return 6;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_actuator_observers_step_n_in(void) { return 6;}
 
-CASADI_SYMBOL_EXPORT casadi_int actuator_observers_step_n_out(void) { return 2;}
+CASADI_SYMBOL_EXPORT casadi_int uvsym_docking_auv_observers_casadi_actuator_observers_step_n_out(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_real actuator_observers_step_default_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT casadi_real uvsym_docking_auv_observers_casadi_actuator_observers_step_default_in(casadi_int i) {
   switch (i) {
     default: return 0;
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* actuator_observers_step_name_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_actuator_observers_step_name_in(casadi_int i) {
   switch (i) {
     case 0: return "x";
     case 1: return "eta";
@@ -4546,7 +4546,7 @@ CASADI_SYMBOL_EXPORT const char* actuator_observers_step_name_in(casadi_int i) {
   }
 }
 
-CASADI_SYMBOL_EXPORT const char* actuator_observers_step_name_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const char* uvsym_docking_auv_observers_casadi_actuator_observers_step_name_out(casadi_int i) {
   switch (i) {
     case 0: return "x_next";
     case 1: return "f_hat";
@@ -4554,7 +4554,7 @@ CASADI_SYMBOL_EXPORT const char* actuator_observers_step_name_out(casadi_int i) 
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* actuator_observers_step_sparsity_in(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_actuator_observers_step_sparsity_in(casadi_int i) {
   switch (i) {
     case 0: return casadi_s2;
     case 1: return casadi_s0;
@@ -4566,7 +4566,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* actuator_observers_step_sparsity_in(casad
   }
 }
 
-CASADI_SYMBOL_EXPORT const casadi_int* actuator_observers_step_sparsity_out(casadi_int i) {
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_docking_auv_observers_casadi_actuator_observers_step_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s2;
     case 1: return casadi_s2;
@@ -4574,7 +4574,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* actuator_observers_step_sparsity_out(casa
   }
 }
 
-CASADI_SYMBOL_EXPORT int actuator_observers_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_actuator_observers_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
@@ -4582,7 +4582,7 @@ CASADI_SYMBOL_EXPORT int actuator_observers_step_work(casadi_int *sz_arg, casadi
   return 0;
 }
 
-CASADI_SYMBOL_EXPORT int actuator_observers_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+CASADI_SYMBOL_EXPORT int uvsym_docking_auv_observers_casadi_actuator_observers_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);

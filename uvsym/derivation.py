@@ -1,0 +1,124 @@
+"""The derivation protocol: how a study plugs into ``uvsym report``, ``verify`` and ``codegen``.
+
+A derivation reproduces one study (usually a paper) with uvsym. It lives outside the package
+(``derivations/`` here, or any installed distribution) and registers a module-level
+:class:`Derivation` as an entry point of the group ``uvsym.derivations``::
+
+    [project.entry-points."uvsym.derivations"]
+    my-study = "my_package.my_study:DERIVATION"
+
+What a derivation implements:
+
+- ``build(out_dir, progress)``: run the study and write ``report.md`` and whatever it links to
+  into ``out_dir``, calling ``progress(message)`` at each step;
+- ``claims()``, optional: its machine-checked claims, a list of
+  :class:`~uvsym.verify.certificate.Certificate`, each with the status it is expected to have
+  (a negative control expects ``"refuted"``);
+- ``observer_sets``, optional: set name -> factory that takes keyword options with defaults
+  (``vehicle``, ``form``, ...) and returns an :class:`~uvsym.codegen.observer_sets.ObserverSet`.
+
+What it gets for free:
+
+- ``uvsym report NAME``: ``build`` into ``reports/NAME/`` and ``report.html`` beside ``report.md``;
+- ``uvsym verify NAME``: the claims checked and tabulated, ``reports/NAME/proofs.json``, exit
+  status 1 when a claim is not as expected;
+- ``uvsym codegen SET -o DIR [--vehicle V] [--form F] [--float]``: the set as a C99 package,
+  options passed to the factory only when given; ``uvsym codegen --list`` lists every set.
+
+Paper-specific numbers (vehicles, gains, faults, the paper's values) belong in the derivation;
+nothing in ``uvsym`` imports one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from importlib.metadata import EntryPoint, entry_points
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+from uvsym.codegen.observer_sets import ObserverSet, make_observer_set
+from uvsym.errors import UnknownNameError, UvsymError
+
+if TYPE_CHECKING:
+    from uvsym.verify.certificate import Certificate
+
+__all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivations", "observer_set",
+           "observer_sets"]
+
+GROUP = "uvsym.derivations"
+
+
+class DerivationError(UvsymError, TypeError):
+    """An installed derivation is malformed: its entry point, or the Derivation it names."""
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """A study as uvsym runs it (module docstring): name (the entry point's), title and parts."""
+
+    name: str
+    title: str
+    build: Callable[[Path, Callable[[str], None]], None]
+    claims: Callable[[], list[Certificate]] | None = None
+    observer_sets: Mapping[str, Callable[..., ObserverSet]] = field(default_factory=dict)
+
+    def __post_init__(self):
+        parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
+                 **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}
+        bad = [part for part, f in parts.items() if not callable(f)]
+        if bad:
+            raise DerivationError(f"derivation {self.name!r}: not callable: {', '.join(bad)}")
+        object.__setattr__(self, "observer_sets", MappingProxyType(dict(self.observer_sets)))
+
+
+def _entry_points() -> dict[str, EntryPoint]:
+    return {ep.name: ep for ep in sorted(entry_points(group=GROUP), key=lambda ep: ep.name)}
+
+
+def _load(ep: EntryPoint) -> Derivation:
+    """The Derivation an entry point names; DerivationError naming the entry point otherwise."""
+    where = f"entry point {ep.name!r} = {ep.value!r} (group {GROUP})"
+    try:
+        loaded = ep.load()
+    except (ImportError, AttributeError) as exc:
+        raise DerivationError(f"{where} cannot be loaded: {exc}") from exc
+    if not isinstance(loaded, Derivation):
+        raise DerivationError(f"{where} is a {type(loaded).__name__}, not a uvsym.derivation.Derivation")
+    if loaded.name != ep.name:
+        raise DerivationError(f"{where} names a Derivation called {loaded.name!r}")
+    return loaded
+
+
+def load_derivations() -> dict[str, Derivation]:
+    """Every installed derivation, by name (sorted); DerivationError for a malformed one."""
+    return {name: _load(ep) for name, ep in _entry_points().items()}
+
+
+def derivation(name: str) -> Derivation:
+    """The installed derivation ``name`` (only it is loaded); UnknownNameError lists the known ones."""
+    available = _entry_points()
+    if name not in available:
+        raise UnknownNameError(f"unknown derivation {name!r}; known: {', '.join(available) or 'none installed'}")
+    return _load(available[name])
+
+
+def observer_sets() -> dict[str, tuple[str, Callable[..., ObserverSet]]]:
+    """Every observer set the installed derivations declare: set name -> (derivation name, factory)."""
+    found: dict[str, tuple[str, Callable[..., ObserverSet]]] = {}
+    for study in load_derivations().values():
+        for name, factory in study.observer_sets.items():
+            if name in found:
+                raise DerivationError(f"observer set {name!r} is declared by both {found[name][0]!r} and "
+                                      f"{study.name!r}")
+            found[name] = (study.name, factory)
+    return dict(sorted(found.items()))
+
+
+def observer_set(name: str, **options) -> ObserverSet:
+    """The observer set ``name`` built with ``options``; UnknownNameError for an unknown set or option."""
+    available = observer_sets()
+    if name not in available:
+        raise UnknownNameError(f"unknown observer set {name!r}; known: {', '.join(available) or 'none declared'}")
+    return make_observer_set(name, available[name][1], **options)
