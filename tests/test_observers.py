@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from uvsym import fixed_thrusters, vectored_thrusters, vehicle
-from uvsym.errors import IdentifiabilityError, ObserverError
+from uvsym.errors import FaultError, IdentifiabilityError, ObserverError
 from uvsym.faults import ActuatorFault, apply_actuator_faults
 from uvsym.observers import KINDS, actuator_observer
 from uvsym.observers.discrete import sampled_observer
@@ -230,7 +230,8 @@ def test_identification_refuses_a_configuration_it_cannot_invert():
         actuator_values(crowded, np.ones(6))
 
 
-@pytest.mark.parametrize("kind, value", [("proportional", 0.7), ("bias", 13.0), ("bias", -0.05)])
+@pytest.mark.parametrize("kind, value", [("proportional", 0.7), ("bias", 13.0), ("bias", -0.05),
+                                         ("loss_of_effectiveness", 0.3)])
 def test_correction_restores_the_desired_actuation(kind, value):
     model = vehicle("docking_auv")
     labels = model.input_labels
@@ -256,6 +257,14 @@ def test_a_stuck_actuator_is_stopped_and_its_share_redistributed():
     residual = config.B @ u_star - config.B @ u_d
     np.testing.assert_allclose(config.B[:, [0, 2]].T @ residual, 0.0, atol=1e-9)
     assert np.linalg.norm(residual) < np.linalg.norm(config.B[:, 1] * u_d[1])  # better than doing nothing
+
+
+def test_correction_refuses_an_unknown_kind_and_an_actuator_with_no_effect_left():
+    labels = ("a", "b")
+    with pytest.raises(FaultError, match="unknown actuator fault kind 'wobble'; known: proportional, bias"):
+        linear_correction({"a": ActuatorFaultEstimate("a", "wobble", 1.0, 0.0)}, labels, np.eye(2))
+    with pytest.raises(IdentifiabilityError, match="b: a proportional fault of 0.0"):
+        linear_correction({"b": ActuatorFaultEstimate("b", "proportional", 0.0, 0.0)}, labels, np.eye(2))
 
 
 def test_correction_keeps_commands_within_bounds():

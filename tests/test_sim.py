@@ -238,6 +238,13 @@ def test_fault_signals_show_what_each_fault_does(docking):
     np.testing.assert_allclose(faulty["fault_sensor"]["z"][t >= 1.0 - 1e-12], 0.5, atol=1e-12)
 
 
+def test_observer_estimates_carry_the_unit_of_their_fault_kind(docking):
+    from uvsym.sim.simulation import observer_blocks
+
+    units = {block.name: block.units for block in observer_blocks(docking.model, docking.observers)}
+    assert units == {"proportional": ("-",) * 6, "bias": ("N", "N", "N", "N m", "N m", "N m")}
+
+
 def test_current_variation_is_seeded_and_has_the_requested_spread(docking):
     from dataclasses import replace
 

@@ -1,4 +1,4 @@
-"""Actuator and sensor faults: time profiles and their symbolic injection.
+"""Actuator and sensor faults: kinds, time profiles and their symbolic injection.
 
 A fault changes a healthy value ``v`` (an actuator's applied value, or a measured state) to
 
@@ -7,31 +7,158 @@ A fault changes a healthy value ``v`` (an actuator's applied value, or a measure
 where ``phi(t)`` in [0, 1] is the fault's time profile and ``target`` its kind (core paper,
 Definition 1, for actuators). Everything is a CasADi expression of ``t``, so integrators, the
 fixed-step path and generated code all see the same fault; ``phi`` is exactly 0 before onset.
+
+Each kind is one object (:class:`ActuatorKind`, :class:`SensorKind`) in the registries
+``ACTUATOR_KINDS`` and ``SENSOR_KINDS``; identification, correction, isolation and units ask it
+instead of testing names, so a new kind is one entry here. Faults keep their kind as its name
+(a string, as scenarios and results write it): ``fault.kind == "bias"``, and
+``fault.kind_object`` (or :func:`actuator_kind` / :func:`sensor_kind`) gives the object.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Callable, ClassVar
 
 import casadi as ca
 
-from uvsym.errors import FaultError
+from uvsym.errors import FaultError, IdentifiabilityError
 
-__all__ = [
-    "PROFILES",
-    "ACTUATOR_KINDS",
-    "SENSOR_KINDS",
-    "Profile",
-    "ActuatorFault",
-    "SensorFault",
-    "apply_actuator_faults",
-    "apply_sensor_faults",
-]
+__all__ = ["PROFILES", "ACTUATOR_KINDS", "SENSOR_KINDS", "ActuatorKind", "SensorKind", "actuator_kind", "sensor_kind",
+           "Profile", "ActuatorFault", "SensorFault", "apply_actuator_faults", "apply_sensor_faults"]
 
 PROFILES = ("step", "ramp", "incipient", "intermittent")
-ACTUATOR_KINDS = ("proportional", "bias", "constant", "loss_of_effectiveness")
-SENSOR_KINDS = ("bias", "drift", "stuck", "noise")
+
+
+@dataclass(frozen=True)
+class _Kind:
+    """A fault kind: its name and the closed interval its values must lie in."""
+
+    TARGET: ClassVar[str]
+    name: str
+    limits: tuple[float, float]
+
+    def check(self, value) -> None:
+        """Raise FaultError unless ``value`` is a finite number within :attr:`limits`."""
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+            raise FaultError(f"{self.TARGET} {self.name} fault value must be a finite number, got {value!r}")
+        lower, upper = self.limits
+        if not lower <= value <= upper:
+            raise FaultError(f"{self.TARGET} {self.name} fault value must be in [{lower:g}, {upper:g}], got {value}")
+
+
+@dataclass(frozen=True)
+class ActuatorKind(_Kind):
+    """How an actuator fault of value f changes the commanded value v (Definition 1).
+
+    Every kind is affine in v and in f: ``deliver(v, f) = (g0 + g1 f) v + (s0 + s1 f)`` with
+    ``gain = (g0, g1)`` (dimensionless) and ``shift = (s0, s1)`` (s0 in v's unit), so
+    identification, correction and the unit of f follow from these four numbers. ``healthy`` is
+    the f that changes nothing (None when that is the command itself, as for constant).
+    """
+
+    TARGET: ClassVar[str] = "actuator"
+    gain: tuple[float, float]
+    shift: tuple[float, float]
+    healthy: float | None
+
+    @property
+    def scales(self) -> bool:
+        """True when f multiplies the command: f is dimensionless and unseen while v = 0 (Remark 2)."""
+        return self.gain[1] != 0.0
+
+    @property
+    def ignores_command(self) -> bool:
+        """True when the delivered value does not depend on the command (a stuck actuator)."""
+        return self.gain == (0.0, 0.0)
+
+    def unit(self, input_unit: str) -> str:
+        """Unit of f for an input in ``input_unit``: ``-`` when f scales, else the input's own."""
+        return "-" if self.scales else input_unit
+
+    def affine(self, f):
+        """(gain, shift) with ``deliver(v, f) = gain v + shift``."""
+        return self.gain[0] + self.gain[1] * f, self.shift[0] + self.shift[1] * f
+
+    def deliver(self, v, f):
+        """The value delivered for command v (float, numpy or CasADi SX/MX/DM)."""
+        gain, shift = self.affine(f)
+        return gain * v + shift
+
+    def identify(self, delivered: float, command: float) -> float:
+        """The f with ``deliver(command, f) = delivered`` (IdentifiabilityError where f has no effect)."""
+        sensitivity = self.gain[1] * command + self.shift[1]
+        if abs(sensitivity) <= 1e-12:
+            raise IdentifiabilityError(f"a {self.name} fault cannot be sized while the desired value is zero")
+        return float((delivered - self.gain[0] * command - self.shift[0]) / sensitivity)
+
+    def severity(self, value, command=None):
+        """``|value - healthy|``, or ``|value - command|`` for a kind without a fixed healthy value (f's unit)."""
+        reference = self.healthy if self.healthy is not None else command
+        if reference is None:
+            raise FaultError(f"a {self.name} fault is healthy only at the command: pass the command")
+        return abs(value - reference)
+
+    def correction(self, value) -> tuple[float, float] | None:
+        """(scale, offset) such that the command ``scale u + offset`` delivers u despite the fault.
+
+        None when the delivered value ignores the command (stop the actuator and hand its share to
+        the others); IdentifiabilityError when the fault leaves the command (almost) no effect.
+        """
+        if self.ignores_command:
+            return None
+        gain, shift = self.affine(value)
+        if abs(gain) <= 1e-9:
+            raise IdentifiabilityError(f"a {self.name} fault of {value} leaves the command no effect to correct")
+        return 1.0 / gain, -shift / gain
+
+
+@dataclass(frozen=True)
+class SensorKind(_Kind):
+    """How a sensor fault of value f changes the measurement of v.
+
+    ``measure(v, f, t, onset, held, noise)`` is the faulty measurement (t, onset in s; held the
+    value latched at the last healthy sample; noise a standard normal draw); ``latches`` is True
+    for a kind that keeps ``held`` from the onset on.
+    """
+
+    TARGET: ClassVar[str] = "sensor"
+    measure: Callable
+    latches: bool = False
+
+
+_ANY = (-math.inf, math.inf)
+ACTUATOR_KINDS = MappingProxyType({kind.name: kind for kind in (
+    ActuatorKind("proportional", _ANY, gain=(0.0, 1.0), shift=(0.0, 0.0), healthy=1.0),  # f v (f_p)
+    ActuatorKind("bias", _ANY, gain=(1.0, 0.0), shift=(0.0, 1.0), healthy=0.0),  # v + f (f_a)
+    ActuatorKind("constant", _ANY, gain=(0.0, 0.0), shift=(0.0, 1.0), healthy=None),  # f, stuck (f_c)
+    ActuatorKind("loss_of_effectiveness", (0.0, 1.0), gain=(1.0, -1.0), shift=(0.0, 0.0), healthy=0.0),  # (1 - f) v
+)})
+SENSOR_KINDS = MappingProxyType({kind.name: kind for kind in (
+    SensorKind("bias", _ANY, lambda v, f, t, onset, held, noise: v + f),
+    SensorKind("drift", _ANY, lambda v, f, t, onset, held, noise: v + f * (t - onset)),  # f per second
+    SensorKind("stuck", _ANY, lambda v, f, t, onset, held, noise: held, latches=True),
+    SensorKind("noise", (0.0, math.inf), lambda v, f, t, onset, held, noise: v + f * noise),  # f: std
+)})
+
+
+def _lookup(registry, name, target: str):
+    if not isinstance(name, str) or name not in registry:
+        raise FaultError(f"unknown {target} fault kind {name!r}; known: {', '.join(registry)}")
+    return registry[name]
+
+
+def actuator_kind(name: str) -> ActuatorKind:
+    """The actuator fault kind called ``name`` (FaultError listing the known ones otherwise)."""
+    return _lookup(ACTUATOR_KINDS, name, "actuator")
+
+
+def sensor_kind(name: str) -> SensorKind:
+    """The sensor fault kind called ``name`` (FaultError listing the known ones otherwise)."""
+    return _lookup(SENSOR_KINDS, name, "sensor")
 
 
 @dataclass(frozen=True)
@@ -83,10 +210,11 @@ class Profile:
 
 @dataclass(frozen=True)
 class ActuatorFault:
-    """A fault on one actuator (index into the model's inputs), in that input's unit.
+    """A fault on one actuator (index into the model's inputs), ``value`` in the kind's unit.
 
-    proportional: ``value * v`` (core paper f_p); bias: ``v + value`` (f_a); constant: ``value``
-    regardless of the command (f_c, stuck); loss_of_effectiveness: ``(1 - value) * v``, value in [0, 1].
+    kind: a name in ACTUATOR_KINDS -- proportional ``value * v`` (core paper f_p); bias
+    ``v + value`` (f_a); constant ``value`` regardless of the command (f_c, stuck);
+    loss_of_effectiveness ``(1 - value) * v``, value in [0, 1].
     """
 
     actuator: int
@@ -95,31 +223,21 @@ class ActuatorFault:
     profile: Profile = Profile()
 
     def __post_init__(self):
-        if self.kind not in ACTUATOR_KINDS:
-            raise FaultError(f"unknown actuator fault kind {self.kind!r}; known: {', '.join(ACTUATOR_KINDS)}")
-        if not math.isfinite(self.value):
-            raise FaultError(f"actuator fault value must be finite, got {self.value}")
-        if self.kind == "loss_of_effectiveness" and not 0.0 <= self.value <= 1.0:
-            raise FaultError(f"loss_of_effectiveness must be in [0, 1], got {self.value}")
+        self.kind_object.check(self.value)
 
-    def target(self, v):
-        """The faulty value the profile blends towards."""
-        if self.kind == "proportional":
-            return self.value * v
-        if self.kind == "bias":
-            return v + self.value
-        if self.kind == "constant":
-            return self.value + 0.0 * v
-        return (1.0 - self.value) * v
+    @property
+    def kind_object(self) -> ActuatorKind:
+        """The :class:`ActuatorKind` named by ``kind``."""
+        return actuator_kind(self.kind)
 
 
 @dataclass(frozen=True)
 class SensorFault:
     """A fault on one measured state (index into x = [eta; nu]), in that state's unit.
 
-    bias: ``y + value``; drift: ``y + value (t - onset)`` (value per second); stuck: the value
-    measured at the last sample before onset; noise: ``y + value n_k``, n_k standard normal per
-    sample (value is the standard deviation).
+    kind: a name in SENSOR_KINDS -- bias ``y + value``; drift ``y + value (t - onset)`` (value
+    per second); stuck: the value measured at the last sample before onset; noise
+    ``y + value n_k``, n_k standard normal per sample (value is the standard deviation, >= 0).
     """
 
     channel: int
@@ -128,12 +246,12 @@ class SensorFault:
     profile: Profile = Profile()
 
     def __post_init__(self):
-        if self.kind not in SENSOR_KINDS:
-            raise FaultError(f"unknown sensor fault kind {self.kind!r}; known: {', '.join(SENSOR_KINDS)}")
-        if not math.isfinite(self.value):
-            raise FaultError(f"sensor fault value must be finite, got {self.value}")
-        if self.kind == "noise" and self.value < 0.0:
-            raise FaultError(f"sensor noise standard deviation must be >= 0, got {self.value}")
+        self.kind_object.check(self.value)
+
+    @property
+    def kind_object(self) -> SensorKind:
+        """The :class:`SensorKind` named by ``kind``."""
+        return sensor_kind(self.kind)
 
 
 def _check_index(index: int, size: int, what: str) -> None:
@@ -148,7 +266,7 @@ def apply_actuator_faults(u, t, faults: tuple[ActuatorFault, ...]):
     for fault in faults:
         _check_index(fault.actuator, m, "actuator")
         v = parts[fault.actuator]
-        parts[fault.actuator] = v + fault.profile.phi(t) * (fault.target(v) - v)
+        parts[fault.actuator] = v + fault.profile.phi(t) * (fault.kind_object.deliver(v, fault.value) - v)
     return ca.vertcat(*parts)
 
 
@@ -163,16 +281,10 @@ def apply_sensor_faults(y, t, faults: tuple[SensorFault, ...], held, noise):
     latch = [y[i] for i in range(n)]
     for fault in faults:
         _check_index(fault.channel, n, "state")
-        i, phi = fault.channel, fault.profile.phi(t)
+        i, phi, kind = fault.channel, fault.profile.phi(t), fault.kind_object
         v = parts[i]
-        if fault.kind == "bias":
-            target = v + fault.value
-        elif fault.kind == "drift":
-            target = v + fault.value * (t - fault.profile.onset)
-        elif fault.kind == "noise":
-            target = v + fault.value * noise[i]
-        else:
-            target = held[i]
+        target = kind.measure(v, fault.value, t, fault.profile.onset, held[i], noise[i])
+        if kind.latches:
             latch[i] = ca.if_else(phi > 0, held[i], v)
         parts[i] = v + phi * (target - v)
     return ca.vertcat(*parts), ca.vertcat(*latch)

@@ -1,10 +1,11 @@
 """Fault-tolerant correction of the commands, not the controller (seeds/000, sec. 3).
 
-For identified faults the corrected command is ``u*_i = u_d,i / f_p,i`` (proportional),
-``u*_i = u_d,i - f_a,i`` (bias), and an actuator with a constant (stuck) fault is stopped and
-its share of ``tau_d`` handed to the others. Commands are then kept within
-``[u_min, u_max]``: what one actuator cannot deliver goes to the redundant ones by bounded
-least squares (``scipy.optimize.lsq_linear``).
+For identified faults the corrected command undoes each fault's kind (its
+:meth:`~uvsym.faults.ActuatorKind.correction`): ``u*_i = u_d,i / f_p,i`` (proportional),
+``u*_i = u_d,i - f_a,i`` (bias), and an actuator whose delivered value ignores its command
+(constant, stuck) is stopped and its share of ``tau_d`` handed to the others. Commands are
+then kept within ``[u_min, u_max]``: what one actuator cannot deliver goes to the redundant
+ones by bounded least squares (``scipy.optimize.lsq_linear``).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from uvsym.errors import IdentifiabilityError
+from uvsym.faults import actuator_kind
 from uvsym.observers.identification import ActuatorFaultEstimate
 
 __all__ = ["Correction", "linear_correction", "corrected_commands"]
@@ -39,14 +41,15 @@ def linear_correction(faults: dict[str, ActuatorFaultEstimate], labels: tuple[st
     stopped = []
     for label, fault in faults.items():
         i = labels.index(label)
-        if fault.kind == "proportional":
-            if abs(fault.value) <= 1e-9:
-                raise IdentifiabilityError(f"{label}: a proportional factor of {fault.value} cannot be corrected")
-            S[i, i] = 1.0 / fault.value
-        elif fault.kind == "bias":
-            o[i] = -fault.value
-        elif fault.kind == "constant":
+        try:
+            correction = actuator_kind(fault.kind).correction(fault.value)
+        except IdentifiabilityError as exc:
+            raise IdentifiabilityError(f"{label}: {exc}") from None
+        if correction is None:
             stopped.append(i)
+        else:
+            S[i, i] = correction[0]
+            o[i] += correction[1]
     for i in stopped:
         others = [j for j in range(m) if j not in stopped]
         if not others:
@@ -61,8 +64,10 @@ def corrected_commands(u_d, faults: dict[str, ActuatorFaultEstimate], labels: tu
     """Corrected commands u* (m,) within bounds: the linear correction, then bounded least squares.
 
     The actuators minimise ``|B_eff (u* - u_lin)|`` subject to bounds, where B_eff weights each
-    actuator by its effectiveness (``f_p`` for proportional faults, 0 for stopped ones) -- so
-    the excess of a saturated actuator goes to the ones that can still act on the same forces.
+    actuator by its effectiveness (the gain its fault leaves: ``f_p`` for proportional faults, 0
+    for stopped ones) -- so the excess of a saturated actuator goes to the ones that can still act
+    on the same forces. A fault's shift (a bias) also narrows the command's bounds so that the
+    command plus the shift stays within them.
     """
     u_d = np.asarray(u_d, dtype=float)
     linear = linear_correction(faults, labels, B)
@@ -70,14 +75,12 @@ def corrected_commands(u_d, faults: dict[str, ActuatorFaultEstimate], labels: tu
     effectiveness = np.ones(len(labels))
     lower, upper = np.asarray(u_min, dtype=float).copy(), np.asarray(u_max, dtype=float).copy()
     for label, fault in faults.items():
-        i = labels.index(label)
-        if fault.kind == "proportional":
-            effectiveness[i] = fault.value
-        elif fault.kind == "constant":
+        i, kind = labels.index(label), actuator_kind(fault.kind)
+        if kind.ignores_command:
             effectiveness[i], lower[i], upper[i] = 0.0, -1e-12, 1e-12
-        elif fault.kind == "bias":
-            lower[i], upper[i] = lower[i] - fault.value, upper[i] - fault.value
-            lower[i], upper[i] = max(lower[i], u_min[i]), min(upper[i], u_max[i])
+        else:
+            effectiveness[i], shift = kind.affine(fault.value)
+            lower[i], upper[i] = max(lower[i] - shift, u_min[i]), min(upper[i] - shift, u_max[i])
     if np.all((u_lin >= lower) & (u_lin <= upper)):
         return u_lin
     B_eff = np.asarray(B, dtype=float) * effectiveness

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvsym.errors import ObserverError
+from uvsym.faults import actuator_kind
 from uvsym.observers.actuator import ActuatorObserver
 
 __all__ = ["GainDesign", "design_gains", "unobservable_channels"]
@@ -33,9 +34,9 @@ class GainDesign:
 def unobservable_channels(observer: ActuatorObserver, tau_d, threshold: float = 1e-6) -> tuple[int, ...]:
     """Channels where a proportional fault cannot be seen (Remark 2): ``|tau_d,i| <= threshold`` (N, N m).
 
-    Always empty for the bias and constant observers.
+    Always empty for observers of kinds that do not scale tau_d (bias, constant).
     """
-    if observer.kind != "proportional":
+    if not actuator_kind(observer.kind).scales:
         return ()
     return tuple(int(i) for i in np.flatnonzero(np.abs(np.asarray(tau_d, float).ravel()) <= threshold))
 
@@ -50,8 +51,8 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
         raise ObserverError(f"time_constant must be positive and finite (s), got {time_constant}")
     n = observer.function.size1_in("x")
     if tau_d is None:
-        if observer.kind == "proportional":
-            raise ObserverError("the proportional observer's rate depends on tau_d: pass the nominal tau_d")
+        if actuator_kind(observer.kind).scales:
+            raise ObserverError(f"the {observer.kind} observer's rate depends on tau_d: pass the nominal tau_d")
         tau_d = np.ones(n)
     tau_d = np.asarray(tau_d, dtype=float).ravel()
     if tau_d.size != n:

@@ -3,9 +3,10 @@
 Near the values ``u_e`` the actuators are expected to deliver, ``tau = tau(u_e) + B (u - u_e)``
 with ``B = d tau / d u`` at (state, u_e) -- exact for actuation affine in u (fins), first order
 for propellers -- so the actuator values that produce a generalised force are
-``u = u_e + B^+ (tau - tau(u_e))`` (eq. 26) when B has full column rank. Severity per actuator
-compares them with the desired values u_d:
-proportional ``f_p = u / u_d``, bias ``f_a = u - u_d``, constant ``f_c = u``.
+``u = u_e + B^+ (tau - tau(u_e))`` (eq. 26) when B has full column rank. The fault's value
+per actuator compares them with the desired values u_d as its kind says
+(:meth:`uvsym.faults.ActuatorKind.identify`): proportional ``f_p = u / u_d``, bias
+``f_a = u - u_d``, constant ``f_c = u``.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from uvsym.errors import IdentifiabilityError
 from uvsym.models.configurations import ActuatorConfiguration, identifiability
 from uvsym.models.model import Model
 
-__all__ = ["ActuatorFaultEstimate", "configuration_at", "actuator_values", "severity"]
+__all__ = ["ActuatorFaultEstimate", "configuration_at", "actuator_values"]
 
 
 @dataclass(frozen=True)
@@ -57,15 +58,3 @@ def actuator_values(config: ActuatorConfiguration, tau, tau_e=None, u_e=None, ro
     u_e = np.zeros(len(config.labels)) if u_e is None else np.asarray(u_e, dtype=float).ravel()
     return u_e + np.linalg.pinv(sub.B) @ (tau - tau_e)[rows]
 
-
-def severity(kind: str, u, u_d) -> float:
-    """f_p = u / u_d, f_a = u - u_d or f_c = u for one actuator (IdentifiabilityError if u_d = 0 for f_p)."""
-    if kind == "proportional":
-        if abs(u_d) <= 1e-12:
-            raise IdentifiabilityError("a proportional fault cannot be sized while the desired value is zero")
-        return float(u / u_d)
-    if kind == "bias":
-        return float(u - u_d)
-    if kind == "constant":
-        return float(u)
-    raise IdentifiabilityError(f"unknown fault kind {kind!r}; known: proportional, bias, constant")

@@ -12,8 +12,9 @@ A matched observer's ``f_bar`` is steady; a mismatched one's wanders with ``tau_
 the observer whose ``f_bar`` has the smallest variance over the window names the fault type once
 that variance is below ``threshold`` (paper: 1e-4) and at most ``margin`` times every other
 observer's -- unless that observer settled at its no-fault value, which names no fault. A
-channel is also healthy when every observer that can see it has settled at its no-fault value
-(bias: within ``healthy_tolerance`` of 0; constant: of tau_d; proportional: within
+channel is also healthy when every observer that can see it has settled at its no-fault value,
+i.e. its fault kind's :meth:`~uvsym.faults.ActuatorKind.severity` is small (bias: within
+``healthy_tolerance`` of 0; constant: of tau_d; proportional, a kind that scales: within
 ``healthy_tolerance_p`` of 1). A channel is not observable to an observer while its convergence
 rate (-A_ii) is below ``1 / window_s`` -- for the proportional observer that is Remark 2's
 ``tau_d,i = 0`` made quantitative; such predictions are NaN, never a division by (almost) zero.
@@ -30,6 +31,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from uvsym.errors import ObserverError
+from uvsym.faults import actuator_kind
 from uvsym.observers.actuator import ActuatorObserver
 
 FITS = ("exponential", "line", "quadratic")
@@ -218,10 +220,9 @@ class Isolator:
             ranked[np.arange(len(rows)), best] = np.inf
             fault = voting.all(axis=1) & (best_var < s.threshold) & (best_var <= s.margin * np.min(ranked, axis=1))
             settled_neutral = np.zeros_like(finite)
-            for j, kind in enumerate(kinds):
-                value, tolerance = {"proportional": (1.0, s.healthy_tolerance_p), "bias": (0.0, s.healthy_tolerance),
-                                    "constant": (self.tau_d[rows, i], s.healthy_tolerance)}[kind]
-                near = np.abs(mean[:, j] - value) <= tolerance
+            for j, kind in enumerate(map(actuator_kind, kinds)):
+                tolerance = s.healthy_tolerance_p if kind.scales else s.healthy_tolerance
+                near = kind.severity(mean[:, j], self.tau_d[rows, i]) <= tolerance
                 settled_neutral[:, j] = finite[:, j] & (var[:, j] < s.threshold) & near
             healthy = (settled_neutral | ~seen).all(axis=1) & settled_neutral.any(axis=1)
             hits = np.flatnonzero(fault | healthy)

@@ -5,8 +5,8 @@ samples just simulated). Once the isolation has decided enough generalised-force
 (rows of B) to recover an actuator -- the decided rows of B identify it, and at least one of
 its decided channels is faulty -- the channels' predicted faults give the delivered force
 ``tau_hat`` on those rows at the decision instant, ``u = u_e + B^+ (tau_hat - tau_d)`` the
-delivered actuator values (eq. 26, u_e what healthy actuators would deliver) and the severity
-follows; the fault kind is the one decided on the faulty channel where the actuator has the
+delivered actuator values (eq. 26, u_e what healthy actuators would deliver) and the fault's
+value follows; the fault kind is the one decided on the faulty channel where the actuator has the
 largest share of authority (|B_ia| times its range). An actuator all of whose channels are
 decided healthy is healthy. With ``correct=True`` the command correction (divide by f_p,
 subtract f_a, stop and redistribute) goes back to the loop and acts from the next supervisor
@@ -19,10 +19,11 @@ import numpy as np
 import scipy.linalg
 
 from uvsym.conventions import FORCE_LABELS
+from uvsym.faults import actuator_kind
 from uvsym.models.model import Model
 from uvsym.observers.actuator import ActuatorObserver
 from uvsym.observers.ftc import Correction, linear_correction
-from uvsym.observers.identification import ActuatorFaultEstimate, actuator_values, configuration_at, severity
+from uvsym.observers.identification import ActuatorFaultEstimate, actuator_values, configuration_at
 from uvsym.observers.isolation import IsolationResult, IsolationSettings, Isolator
 
 __all__ = ["FaultDiagnosis"]
@@ -107,8 +108,7 @@ class FaultDiagnosis:
         tau_hat = tau_d.copy()
         for i in faulty:
             decision, row = result.decisions[self.channels[i]], rows[i]
-            tau_hat[row] = {"proportional": decision.f_bar * tau_d[row], "bias": tau_d[row] + decision.f_bar,
-                            "constant": decision.f_bar}[decision.kind]
+            tau_hat[row] = actuator_kind(decision.kind).deliver(tau_d[row], decision.f_bar)
         u_hat = actuator_values(config, tau_hat, tau_d, u_e, rows=[rows[i] for i in decided])
         # an actuator's fault kind is read on the faulty channel where it has the largest share of authority
         authority = np.abs(B) * (self.model.u_max - self.model.u_min)
@@ -116,5 +116,5 @@ class FaultDiagnosis:
         for a in candidates:
             channel = max((i for i in faulty if support[i, a]), key=lambda i: share[i, a])
             kind = result.decisions[self.channels[channel]].kind
-            self.identified[self.labels[a]] = ActuatorFaultEstimate(self.labels[a], kind,
-                                                                    severity(kind, u_hat[a], u_e[a]), time_s)
+            value = actuator_kind(kind).identify(u_hat[a], u_e[a])
+            self.identified[self.labels[a]] = ActuatorFaultEstimate(self.labels[a], kind, value, time_s)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.errors import FaultError, ModelError, ScenarioError, UnknownNameError
-from uvsym.faults import ActuatorFault, Profile, SensorFault
+from uvsym.faults import ActuatorFault, Profile, SensorFault, actuator_kind
 from uvsym.models.model import Model
 from uvsym.models.registry import vehicle
 from uvsym.observers import FORMS, KINDS
@@ -271,7 +271,7 @@ def _observer(fields: _Fields, dof: int) -> ObserverSpec:
     spec = ObserverSpec(kind=kind, form=fields.text("form", "paper", choices=FORMS),
                         time_constant=fields.number("time_constant", positive=True),
                         tau_d=None if not fields.has("tau_d") else tuple(fields.vector("tau_d", dof)))
-    if kind == "proportional" and spec.tau_d is None:
-        raise ScenarioError(f"{fields.path}.tau_d: the proportional observer's gain design needs a nominal tau_d")
+    if actuator_kind(kind).scales and spec.tau_d is None:
+        raise ScenarioError(f"{fields.path}.tau_d: the {kind} observer's gain design needs a nominal tau_d")
     fields.done()
     return spec

@@ -6,7 +6,7 @@ import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
-from uvsym.faults import ActuatorFault, SensorFault
+from uvsym.faults import ActuatorFault, SensorFault, actuator_kind
 from uvsym.models.model import Model
 from uvsym.observers import ActuatorObserver, actuator_observer
 from uvsym.observers.gains import design_gains
@@ -127,9 +127,9 @@ def current_profile(scenario: Scenario):
 
 
 def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...]) -> tuple[ObserverBlock, ...]:
-    """The scenario's observers as blocks of the closed loop, named by their kind."""
+    """The scenario's observers as blocks of the closed loop, named by their kind (f_hat in the kind's unit)."""
     return tuple(ObserverBlock(kind, observer.function, K, FORCE_LABELS[model.dof],
-                               ("-",) * model.dof if kind == "proportional" else model.force_units)
+                               tuple(map(actuator_kind(kind).unit, model.force_units)))
                  for kind, (observer, K) in scenario_observers(model, specs).items())
 
 
