@@ -23,25 +23,25 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from c_timing import c_loop_ns  # noqa: E402
 
 from uvsym.codegen import find_compiler
-from uvsym.codegen.observer_sets import observer_set
-from uvsym.codegen.package import write_package
+from uvsym.derivation import observer_set
 
 RESULTS = Path(__file__).resolve().parent / "results" / "codegen.json"
 
 
 def main() -> dict:
-    name, description, functions = observer_set("actuator-observers", vehicle_name="remus100", form="momentum")
-    combined = functions[-1].function
+    observers = observer_set("actuator-observers", vehicle="remus100", form="momentum")
+    name = observers.package_name
+    combined = observers.exported[-1].function
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
-        write_package(folder, functions, name, "double", description)
-        setup = """
-  static uvsym_real x[18], eta[6] = {0, 0, 5, 0.01, 0.02, 0.3}, nu[6] = {1.5, 0.1, 0.02, 0.01, 0.01, 0.02};
-  static uvsym_real tau[6] = {10, 1, 2, 0.1, 1, 0.5}, K[18], dt[1] = {0.01}, x_next[18], f_hat[18];
+        observers.write(folder)
+        setup = f"""
+  static {name}_real x[18], eta[6] = {{0, 0, 5, 0.01, 0.02, 0.3}}, nu[6] = {{1.5, 0.1, 0.02, 0.01, 0.01, 0.02}};
+  static {name}_real tau[6] = {{10, 1, 2, 0.1, 1, 0.5}}, K[18], dt[1] = {{0.01}}, x_next[18], f_hat[18];
   int k;
   for (k = 0; k < 18; ++k) K[k] = 1.0;"""
         step_ns = c_loop_ns([folder / "src" / f"{name}_casadi.c", folder / "src" / f"{name}.c"], folder / "include",
-                            f"{name}.h", setup, "uvsym_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat)",
+                            f"{name}.h", setup, f"{name}_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat)",
                             "nu[0]", 1.5, "f_hat[0]")
     args = [np.zeros(18), np.array([0, 0, 5, 0.01, 0.02, 0.3]), np.array([1.5, 0.1, 0.02, 0.01, 0.01, 0.02]),
             np.array([10, 1, 2, 0.1, 1, 0.5]), np.ones(18), np.array([0.01])]

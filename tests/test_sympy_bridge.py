@@ -10,7 +10,7 @@ import sympy as sp
 from uvsym import vehicle
 from uvsym.errors import UvsymError
 from uvsym.observers import actuator_observer
-from uvsym.report.sympy_bridge import latex, to_sympy
+from uvsym.sympy_bridge import latex, to_sympy
 
 
 def _round_trip_error(inputs: list, expression) -> float:

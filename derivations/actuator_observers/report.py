@@ -6,7 +6,7 @@ import casadi as ca
 
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
 from uvsym.report import markdown_table
-from uvsym.report.sympy_bridge import latex
+from uvsym.sympy_bridge import latex
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import scenario_observers
 

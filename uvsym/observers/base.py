@@ -21,7 +21,7 @@ What a new estimator implements (like ``scipy.integrate.OdeSolver``'s ``_step_im
 
 What it gets for free: it runs in any closed loop wired by signal name (:mod:`uvsym.sim.wiring`),
 scalar or compiled; it exports to C (:mod:`uvsym.codegen`); a report renders its equations
-(:mod:`uvsym.report.sympy_bridge`); its size errors are caught here, before anything runs.
+(:mod:`uvsym.report.equations`); its size errors are caught here, before anything runs.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ import casadi as ca
 import sympy as sp
 
 from uvsym.errors import UvsymError
-from uvsym.report.sympy_bridge import latex, to_sympy
+from uvsym.sympy_bridge import latex, to_sympy
 from uvsym.systems.signals import Signals
 
 __all__ = ["signal_latex", "function_equations", "observer_equations"]

@@ -18,7 +18,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from uvsym.report.sympy_bridge import to_sympy
+from uvsym.sympy_bridge import to_sympy
 from uvsym.verify.certificate import Certificate
 
 __all__ = ["prove_identity"]
