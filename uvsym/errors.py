@@ -15,6 +15,7 @@ __all__ = [
     "ScenarioError",
     "SimulationError",
     "ObserverError",
+    "WiringError",
     "CodegenError",
     "VerificationError",
 ]
@@ -54,6 +55,11 @@ class SimulationError(UvsymError, RuntimeError):
 
 class ObserverError(UvsymError, ValueError):
     """An observer cannot be built or run as asked (unobservable channel, bad gain, wrong sizes)."""
+
+
+class WiringError(UvsymError, ValueError):
+    """Blocks cannot be joined into a loop (names the signal: unread, published twice, undriven
+    plant input, algebraic loop)."""
 
 
 class CodegenError(UvsymError, RuntimeError):

@@ -15,7 +15,7 @@ so that an actuator's own lag is not mistaken for a fault.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -55,7 +55,8 @@ class ClosedLoop:
     logged signals; plant_ode(s, u_cmd, env, t) -> s_dot for s = [x; a]; step(z, w) -> (z_next, out)
     the fixed-step path (discrete part, then ``substeps`` RK4 steps of the plant). ``layout`` maps
     the parts of z (x, a, xc, xo, a_expected, held) to their slices; ``sampled`` the observers'
-    sampled-data forms by name, ``observer_slices`` their states within xo.
+    sampled-data forms by name, ``observer_slices`` their states within xo. ``env_columns``,
+    ``correction_columns``: where w holds (V_c, beta_c) and (vec(S), o); no substitution channels.
     """
 
     model: Model
@@ -71,6 +72,9 @@ class ClosedLoop:
     observer_slices: dict
     sampled: dict[str, SampledObserver]
     signals: dict  # name -> (slice of out, labels, units)
+    env_columns: slice
+    correction_columns: slice
+    substitution_columns: dict = field(default_factory=dict)
 
 
 def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
@@ -158,4 +162,5 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                        ["z", "w"], ["z_next", "out"], {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
                       plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
-                      sampled=sampled, signals=signals)
+                      sampled=sampled, signals=signals, env_columns=slice(1 + n, 3 + n),
+                      correction_columns=slice(3 + n, n_w))

@@ -6,8 +6,11 @@ the system C compiler when there is one (otherwise interpreted, with ``mapaccum`
 (``integrator(name, plugin, dae, t0, grid)``) while the same discrete part runs in between.
 
 A supervisor (isolation, identification, correction) runs every ``supervisor.period`` seconds on
-the samples of the chunk just simulated and may return a new command correction ``(S, o)``,
-which acts from the next chunk on.
+the samples of the chunk just simulated and may return a decision that acts from the next chunk
+on: a new command correction ``(S, o)`` (the marine loop), or a :class:`Substitution` switching
+measurement substitution channels (a loop wired by :func:`uvsym.sim.wiring.interconnect`). A loop
+says where its per-sample input w holds them: ``correction_columns``, ``substitution_columns``
+(channel -> column), and the plant's environment ``env_columns``.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from dataclasses import dataclass
 from typing import Protocol
 
 import casadi as ca
@@ -25,8 +29,9 @@ from uvsym.errors import CodegenError, SimulationError
 from uvsym.observers.ftc import Correction
 from uvsym.sim.closed_loop import ClosedLoop
 from uvsym.sim.result import Signal, SimResult
+from uvsym.sim.wiring import WiredLoop
 
-__all__ = ["METHODS", "Correction", "Supervisor", "run_closed_loop"]
+__all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop"]
 
 METHODS = ("fast", "cvodes", "idas", "rk", "collocation")
 # samples per call between progress reports (no supervisor): the fast path pays per call, the
@@ -35,26 +40,36 @@ CHUNK = {"fast": 10000, "integrator": 100}
 ACCURATE = {"cvodes": {"abstol": 1e-12, "reltol": 1e-12}, "idas": {"abstol": 1e-12, "reltol": 1e-12}}
 
 
+@dataclass(frozen=True)
+class Substitution:
+    """Measurement substitution: the channels switched on (every other channel off), by name."""
+
+    channels: frozenset[str] = frozenset()
+
+    def __post_init__(self):
+        channels = (self.channels,) if isinstance(self.channels, str) else self.channels
+        object.__setattr__(self, "channels", frozenset(channels))
+
+
 class Supervisor(Protocol):
     """Discrete logic run every ``period`` seconds on the latest chunk of samples."""
 
     period: float
 
-    def update(self, t: np.ndarray, signals: dict[str, np.ndarray]) -> Correction | None:
-        """t: (k,) sample times (s); signals: name -> (k, n) values. Returns a new correction or None."""
+    def update(self, t: np.ndarray, signals: dict[str, np.ndarray]) -> Correction | Substitution | None:
+        """t: (k,) sample times (s); signals: name -> (k, n) values. Returns a new decision or None."""
 
 
-def run_closed_loop(loop: ClosedLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
+def run_closed_loop(loop: ClosedLoop | WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
                     compiled: bool = True, progress=None) -> tuple[SimResult, dict]:
     """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
 
-    The correction columns of W are overwritten by the supervisor's corrections. Returns the
+    The decision columns of W are overwritten by the supervisor's decisions. Returns the
     result (samples at every grid time, meta without the caller's part) and timing information.
     """
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
-    m = loop.model.n_inputs
     N = W.shape[0] - 1
     if supervisor is not None:
         chunk = max(1, round(supervisor.period / loop.dt))
@@ -62,7 +77,6 @@ def run_closed_loop(loop: ClosedLoop, z0: np.ndarray, W: np.ndarray, *, method: 
         chunk = CHUNK["fast" if method == "fast" else "integrator"]
     W = np.ascontiguousarray(W, dtype=float)
     outputs = np.empty((N + 1, loop.discrete.size1_out("out")))
-    correction_columns = slice(loop.n_w - m * m - m, loop.n_w)
     advance, build_s = _stepper(loop, method, min(chunk, N), options or {}, compiled)
     z = np.asarray(z0, dtype=float)
     started = time.perf_counter()
@@ -74,10 +88,10 @@ def run_closed_loop(loop: ClosedLoop, z0: np.ndarray, W: np.ndarray, *, method: 
                                   f"t = {(start + k) * loop.dt:.6g} s ({method}); try a smaller step")
         if supervisor is not None:
             signals = {name: outputs[start:start + k, sl] for name, (sl, _, _) in loop.signals.items()}
-            correction = supervisor.update(W[start:start + k, 0], signals)
-            if correction is not None:
-                W[start + k:, correction_columns] = np.concatenate(
-                    [np.asarray(correction.S, float).reshape(-1, order="F"), np.asarray(correction.o, float)])
+            decision = supervisor.update(W[start:start + k, 0], signals)
+            if decision is not None:
+                columns, values = _decision_columns(loop, decision)
+                W[start + k:, columns] = values
         if progress is not None:
             progress((start + k) / N)
     outputs[N] = np.asarray(loop.discrete(z, W[N])[2]).ravel()
@@ -87,7 +101,23 @@ def run_closed_loop(loop: ClosedLoop, z0: np.ndarray, W: np.ndarray, *, method: 
     return SimResult(W[:, 0].copy(), signals, {}), timing
 
 
-def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled: bool):
+def _decision_columns(loop: ClosedLoop | WiredLoop, decision) -> tuple[slice | list[int], np.ndarray]:
+    """Where in w a supervisor's decision goes and its values; SimulationError for one the loop cannot take."""
+    if isinstance(decision, Correction) and loop.correction_columns is not None:
+        return loop.correction_columns, np.concatenate([np.asarray(decision.S, float).reshape(-1, order="F"),
+                                                        np.asarray(decision.o, float)])
+    if isinstance(decision, Substitution):
+        channels = loop.substitution_columns
+        unknown = sorted(decision.channels - set(channels))
+        if unknown:
+            raise SimulationError(f"supervisor switched on substitution channels {unknown} the loop does not have; "
+                                  f"channels: {', '.join(channels) or 'none'}")
+        return list(channels.values()), np.array([float(c in decision.channels) for c in channels])
+    raise SimulationError(f"supervisor returned {type(decision).__name__}, which this loop cannot apply; "
+                          f"expected {'Correction' if loop.correction_columns is not None else 'Substitution'} or None")
+
+
+def _stepper(loop: ClosedLoop | WiredLoop, method: str, chunk: int, options: dict, compiled: bool):
     """(advance(z, W_rows, out_rows) -> z_end, seconds spent building); advance fills out_rows (k, n_out)."""
     started = time.perf_counter()
     if method == "fast":
@@ -116,9 +146,10 @@ def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled:
 
         return advance, time.perf_counter() - started
 
-    n_s, m = loop.n_s, loop.model.n_inputs
-    s, p, tau = ca.SX.sym("s", n_s), ca.SX.sym("p", m + 3), ca.SX.sym("tau")
-    dae = {"x": s, "p": p, "t": tau, "ode": loop.plant_ode(s, p[:m], p[m:m + 2], p[m + 2] + tau)}
+    n_s, m, env_columns = loop.n_s, loop.discrete.size1_out("u_cmd"), loop.env_columns
+    n_env = env_columns.stop - env_columns.start
+    s, p, tau = ca.SX.sym("s", n_s), ca.SX.sym("p", m + n_env + 1), ca.SX.sym("tau")
+    dae = {"x": s, "p": p, "t": tau, "ode": loop.plant_ode(s, p[:m], p[m:m + n_env], p[m + n_env] + tau)}
     opts = {**ACCURATE.get(method, {}), **options}
     try:
         integrator = ca.integrator("plant", method, dae, 0.0, loop.dt, opts)
@@ -126,8 +157,6 @@ def _stepper(loop: ClosedLoop, method: str, chunk: int, options: dict, compiled:
         raise SimulationError(f"cannot build the {method} integrator with options {opts}: "
                               f"{str(exc).splitlines()[-1]}") from None
     discrete = loop.discrete
-    n = 2 * loop.model.dof
-    env_columns = slice(1 + n, 3 + n)
 
     def advance(z, W_rows, out_rows):
         for i, w in enumerate(W_rows):

@@ -1,0 +1,263 @@
+"""Closed loops of any System, wired by signal name (like python-control's ``interconnect``).
+
+The loop publishes its time ``t`` (s); the plant publishes its measured outputs under its output
+names and reads its inputs under its input names; each block reads and publishes the signals its
+Signals name. A read named N gets the one signal published as N; a read named ``N.raw`` gets N
+as published, never substituted (unless some block publishes ``N.raw`` itself).
+
+State ``z = [x (n_x); s of each block, in order; held (n_y)]``: plant state, block states, and
+the outputs latched at the last sample before a stuck sensor fault. Per-sample input
+``w = [t; noise (n_y); d (n_d); on (n_c)]``: time (s), standard normal draws for sensor noise,
+the plant's disturbances, and one switch (0 or 1) per substitution channel. At each sample
+
+    y_k = h(x_k, u_f(u_k, t_k), p) + sensor faults,     blocks: s_{k+1}, out_k = step(s_k, r_k)
+
+in the order the outputs depend on each other; the plant inputs u_k are held over the sample
+while ``x' = f(x, u_f(u_k, t), d_k, p)`` is integrated, with actuator faults u_f in continuous
+time. Measurement substitution ``{"psi": "psi_hat"}``: while channel psi is on, every block that
+reads ``psi`` gets ``psi_hat`` instead, except the block publishing ``psi_hat`` (an estimator
+keeps seeing its sensor); switches are columns of w, set by a supervisor's ``Substitution``.
+"""
+
+from __future__ import annotations
+
+import graphlib
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from uvsym.errors import WiringError
+from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
+from uvsym.sim.blocks import Block
+from uvsym.symbolic import rk4
+from uvsym.systems.signals import Signals
+from uvsym.systems.system import System
+
+__all__ = ["WiredLoop", "interconnect", "RESERVED", "RAW"]
+
+RESERVED = ("x", "y", "u", "t", "held", "fault_sensor", "fault_actuator", "substitution")  # result groups
+RAW = ".raw"
+
+
+@dataclass(frozen=True)
+class WiredLoop:
+    """A loop of a System and blocks, run by :func:`uvsym.sim.run.run_closed_loop`.
+
+    discrete(z, w) -> (z_disc, u_cmd, out): z_disc = z[n_s:] of the next sample, u_cmd the plant
+    inputs held over the sample, out the logged signals (``signals``: group -> (slice of out,
+    labels, units)); plant_ode(s, u_cmd, env, t) -> s_dot with s = x and env = d; step(z, w) ->
+    (z_next, out) the fixed-step path (``substeps`` RK4 steps per sample). reads(z, w) -> what
+    each block reads, one output per block (named by it); names: the published signals; units:
+    name -> unit; order: their evaluation order. layout: part of z (x, each block's name, held) -> slice; env_columns,
+    substitution_columns (channel -> column): where w holds d and the switches.
+    """
+
+    plant: System
+    blocks: tuple[Block, ...]
+    p: np.ndarray
+    dt: float
+    substeps: int
+    n_z: int
+    n_w: int
+    n_s: int
+    discrete: ca.Function
+    plant_ode: ca.Function
+    step: ca.Function
+    reads: ca.Function
+    names: tuple[str, ...]
+    units: dict[str, str]
+    order: tuple[str, ...]
+    layout: dict[str, slice]
+    signals: dict
+    env_columns: slice
+    substitution_columns: dict[str, int]
+    correction_columns: slice | None = None
+
+
+def _column(items) -> ca.SX:
+    return ca.vertcat(*items) if items else ca.SX(0, 1)
+
+
+def _check(plant: System, blocks: tuple[Block, ...], dt: float, substeps: int) -> None:
+    """WiringError for a discrete plant, a bad period, repeated or reserved block names, a block
+    designed for another period."""
+    if plant.discrete:
+        raise WiringError(f"plant {plant.name} is discrete (dt = {plant.dt} s); wire its continuous form")
+    if not (np.isfinite(dt) and dt > 0) or not (isinstance(substeps, int) and substeps >= 1):
+        raise WiringError(f"dt must be positive (s) and substeps a positive integer, got {dt} and {substeps!r}")
+    for b in blocks:
+        if not isinstance(b, Block):
+            raise WiringError(f"blocks must be Block objects, got {type(b).__name__}")
+    names = [b.name for b in blocks]
+    for b in blocks:
+        if names.count(b.name) > 1 or b.name in RESERVED:
+            raise WiringError(f"block name {b.name!r} is used twice or reserved ({', '.join(RESERVED)})")
+        if b.dt is not None and abs(b.dt - dt) > 1e-9 * dt:
+            raise WiringError(f"block {b.name} was designed for dt = {b.dt} s; the loop samples every {dt} s")
+
+
+def _publishers(plant: System, blocks: tuple[Block, ...]) -> tuple[dict[str, str], dict[str, str]]:
+    """(signal -> who publishes it, signal -> unit it declares); WiringError for a name published twice."""
+    who, units = {"t": "the loop"}, {"t": "s"}
+    groups = [(f"plant {plant.name}", plant.y)] + [(f"block {b.name}", b.publishes) for b in blocks]
+    for label, group in groups:
+        for name, unit in zip(group.names, group.units):
+            if name in who:
+                raise WiringError(f"signal {name!r} is published twice: by {who[name]} and by {label}")
+            who[name], units[name] = label, unit
+    return who, units
+
+
+def _source(name: str, who: dict[str, str], reader: str, plant: System) -> str:
+    """The published signal a read of ``name`` joins (N for ``N.raw``); WiringError if none."""
+    base = name[:-len(RAW)] if name.endswith(RAW) and name not in who else name
+    if base in who:
+        return base
+    known = ", ".join(sorted(who))
+    if reader == f"plant {plant.name}":
+        raise WiringError(f"plant {plant.name} input {name!r} is driven by no block; published: {known}")
+    raise WiringError(f"{reader} reads {name!r}, which nothing publishes; published: {known}")
+
+
+def _resolve_units(readers: list[tuple[str, Signals]], who: dict, declared: dict, plant: System) -> dict:
+    """Units of every published signal: the publisher's, else the first reader's; WiringError on a mismatch."""
+    units = dict(declared)
+    for reader, group in readers:
+        for name, unit in zip(group.names, group.units):
+            source = _source(name, who, reader, plant)
+            units[source] = units[source] or unit
+    for reader, group in readers:
+        for name, unit in zip(group.names, group.units):
+            source = _source(name, who, reader, plant)
+            if unit and unit != units[source]:
+                raise WiringError(f"{reader} reads {name!r} in {unit!r} but {who[source]} publishes it in "
+                                  f"{units[source]!r}")
+    return units
+
+
+def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str]) -> tuple[list[str], dict]:
+    """(evaluation order, signal -> its expression free of placeholders).
+
+    ``exprs[n]`` is signal n in terms of the placeholders ``P`` of the signals it reads; the
+    dependencies are the structural ones (``jacobian_sparsity``), sorted topologically, then each
+    placeholder is replaced by its signal in that order. WiringError naming a cycle.
+    """
+    names = list(P)
+    pattern = ca.jacobian_sparsity(ca.vertcat(*[exprs[n] for n in names]), ca.vertcat(*[P[n] for n in names]))
+    deps: dict[str, list[str]] = {n: [] for n in names}
+    for row, col in zip(*pattern.get_triplet()):
+        deps[names[row]].append(names[col])
+    try:
+        order = list(graphlib.TopologicalSorter(deps).static_order())
+    except graphlib.CycleError as exc:
+        cycle = " -> ".join(f"{n} ({who[n]})" for n in exc.args[1])
+        raise WiringError(f"algebraic loop: {cycle}; each signal needs the next within the same sample "
+                          "(break it with a block whose output does not depend on its input)") from None
+    values = {}
+    for name in order:
+        used = deps[name]
+        values[name] = ca.substitute([exprs[name]], [P[n] for n in used], [values[n] for n in used])[0]
+    return order, values
+
+
+def _logged(parts: dict[str, tuple]) -> tuple[ca.SX, dict]:
+    """(out, group -> (slice of out, labels, units)) from group -> (expression, labels, units)."""
+    signals, offset = {}, 0
+    for group, (expr, labels, units) in parts.items():
+        signals[group] = (slice(offset, offset + expr.numel()), tuple(labels), tuple(units))
+        offset += expr.numel()
+    return ca.vertcat(*[expr for expr, _, _ in parts.values()]), signals
+
+
+def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[ActuatorFault, ...] = (),
+                 sensor_faults: tuple[SensorFault, ...] = (), substitutions: dict[str, str] | None = None,
+                 substeps: int = 1, p=None) -> WiredLoop:
+    """The loop of ``plant`` and ``blocks`` sampled every ``dt`` s (module docstring).
+
+    Actuator faults index the plant's inputs, sensor faults its outputs; p: plant parameters
+    (default ``plant.p0``); substitutions: channel -> the signal that replaces it when on.
+
+    Raises
+    ------
+    WiringError
+        For a read nobody publishes (names the block, the signal and the published ones), a signal
+        published twice, a plant input no block drives, an algebraic loop (names the cycle), an
+        unknown substitution, a unit mismatch, or a block designed for another sample period.
+    """
+    blocks = tuple(blocks)
+    _check(plant, blocks, dt, substeps)
+    p = ca.DM(plant.p.vector(plant.p0 if p is None else p, f"{plant.name}: parameters p"))
+    substitutions = dict(substitutions or {})
+    who, declared = _publishers(plant, blocks)
+    plant_label = f"plant {plant.name}"
+    readers = [(f"block {b.name}", b.reads) for b in blocks] + [(plant_label, plant.u)]
+    readers += [(f"substitution {c!r} -> {s!r}", Signals((c, s), ("", ""))) for c, s in substitutions.items()]
+    units = _resolve_units(readers, who, declared, plant)
+    for channel, substitute in substitutions.items():  # one quantity: an empty unit is the other's
+        if units[channel] and units[substitute] and units[channel] != units[substitute]:
+            raise WiringError(f"substitution {channel!r} -> {substitute!r}: units {units[channel]!r} and "
+                              f"{units[substitute]!r} differ")
+        units[channel] = units[substitute] = units[channel] or units[substitute]
+
+    n_x, n_y, n_d, n_c = plant.x.size, plant.y.size, plant.d.size, len(substitutions)
+    layout, start = {}, 0
+    for part, size in [("x", n_x)] + [(b.name, b.state.size) for b in blocks] + [("held", n_y)]:
+        layout[part], start = slice(start, start + size), start + size
+    n_z, n_w = start, 1 + n_y + n_d + n_c
+    z, w = ca.SX.sym("z", n_z), ca.SX.sym("w", n_w)
+    x, held, t = z[layout["x"]], z[layout["held"]], w[0]
+    noise, d, on = w[1:1 + n_y], w[1 + n_y:1 + n_y + n_d], w[1 + n_y + n_d:]
+    switch = {channel: on[i] for i, channel in enumerate(substitutions)}
+    P = {name: ca.SX.sym(name) for name in who}
+
+    def read(reader: str, group: Signals) -> ca.SX:
+        values = []
+        for name in group.names:
+            source = _source(name, who, reader, plant)
+            value = P[source]
+            if name in switch and who[substitutions[name]] != reader:
+                value = ca.if_else(switch[name], P[substitutions[name]], value)
+            values.append(value)
+        return _column(values)
+
+    exprs, s_next, reads = {"t": t}, [], []
+    for b in blocks:
+        reads.append(read(f"block {b.name}", b.reads))
+        s_b, out_b = b.step(z[layout[b.name]], reads[-1])
+        s_next.append(s_b)
+        exprs.update({name: out_b[i] for i, name in enumerate(b.publishes.names)})
+    u_cmd = read(plant_label, plant.u)
+    u_applied = apply_actuator_faults(u_cmd, t, actuator_faults)
+    y_true = plant.h(x, u_applied, p)
+    y, held_next = apply_sensor_faults(y_true, t, sensor_faults, held, noise)
+    exprs.update({name: y[i] for i, name in enumerate(plant.y.names)})
+    order, values = _resolve(exprs, P, who)
+    parts = {"x": (x, plant.x, plant.x.units), "y": (y, plant.y, plant.y.units),
+             "u": (u_applied, plant.u, plant.u.units)}
+    for b in blocks:
+        parts[b.name] = (_column([exprs[n] for n in b.publishes.names]), b.publishes,
+                         tuple(units[n] for n in b.publishes.names))
+    parts["fault_sensor"] = (y - y_true, plant.y, plant.y.units)
+    parts["fault_actuator"] = (u_applied - u_cmd, plant.u, plant.u.units)
+    if substitutions:
+        parts["substitution"] = (on, tuple(substitutions), ("-",) * n_c)
+    out, signals = _logged(parts)
+    names = tuple(P)
+    resolved = ca.substitute([u_cmd, _column(s_next + [held_next]), out] + reads, [P[n] for n in names],
+                             [values[n] for n in names])
+    u_cmd, z_disc, out, *reads = (ca.densify(e) for e in resolved)
+    discrete = ca.Function("wired_loop_discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
+    reads = ca.Function("wired_loop_reads", [z, w], reads, ["z", "w"], [b.name for b in blocks])
+
+    s, uc, env, ts = ca.SX.sym("s", n_x), ca.SX.sym("u_cmd", plant.u.size), ca.SX.sym("env", n_d), ca.SX.sym("t")
+    s_dot = plant.f(s, apply_actuator_faults(uc, ts, actuator_faults), env, p)
+    plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
+    x_next = rk4(plant_ode, x, dt, substeps, u_cmd, d, t=t)
+    step = ca.Function("wired_loop_step", [z, w], [ca.densify(ca.vertcat(x_next, z_disc)), out], ["z", "w"],
+                       ["z_next", "out"], {"cse": True})
+    return WiredLoop(plant=plant, blocks=blocks, p=np.asarray(p).ravel(), dt=float(dt), substeps=substeps, n_z=n_z,
+                     n_w=n_w, n_s=n_x, discrete=discrete, plant_ode=plant_ode, step=step, reads=reads,
+                     names=names, units=units, order=tuple(order), layout=layout, signals=signals,
+                     env_columns=slice(1 + n_y, 1 + n_y + n_d),
+                     substitution_columns={channel: 1 + n_y + n_d + i for i, channel in enumerate(substitutions)})
