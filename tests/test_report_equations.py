@@ -52,3 +52,15 @@ def test_interval_sine_of_exact_zero_is_exact_zero():
         bounds = IntervalFunction(ca.Function("g", [a], [op(a)]))(np.array([[0.0], [0.0]]), np.array([[0.0], [1e-3]]))
         assert bounds.lo[0, 0] == 0.0 and bounds.hi[0, 0] == 0.0
         assert bounds.hi[1, 0] > 0.0  # a box that is not a point still gets its width
+
+
+def test_golden_text_comparison_tolerates_rounding_but_not_changes():
+    from uvsym.testing import assert_same_text
+
+    assert_same_text("K 1.11e-14, t = 3.1788 s, w12[3]", "K 1.39e-14, t = 3.1788 s, w12[3]")
+    with pytest.raises(AssertionError, match="number 3.1789 differs"):
+        assert_same_text("t = 3.1789 s", "t = 3.1788 s")
+    with pytest.raises(AssertionError, match="text differs"):
+        assert_same_text("t = 3 s", "t = 3 ms")
+    with pytest.raises(AssertionError, match="text differs"):
+        assert_same_text("casadi_f1(w)", "casadi_f2(w)")  # digits inside names are text

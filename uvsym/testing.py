@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
+import re
+
 from uvsym.verify.certificate import Certificate
 
-__all__ = ["assert_proved", "assert_refuted"]
+__all__ = ["assert_proved", "assert_refuted", "assert_same_text"]
 
 
 def assert_proved(certificate: Certificate) -> None:
@@ -18,3 +21,21 @@ def assert_refuted(certificate: Certificate) -> None:
     """AssertionError unless the claim was refuted with a counterexample."""
     if certificate.status != "refuted" or not certificate.counterexample:
         raise AssertionError(f"not refuted with a counterexample: {certificate.claim} ({certificate.status})")
+
+
+_NUMBER = re.compile(r"(?<![A-Za-z0-9_.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![A-Za-z0-9_])")
+
+
+def assert_same_text(built: str, committed: str, rtol: float = 1e-6, atol: float = 1e-9, what: str = "text") -> None:
+    """AssertionError unless two texts (a report, an SVG, C source) agree: the same words and
+    punctuation, and every number within ``atol + rtol |committed|`` (golden files that pass on
+    any machine: rounding residues such as 1.1e-14 vs 1.4e-14 differ by less than atol)."""
+    words_built, words_committed = _NUMBER.split(built), _NUMBER.split(committed)
+    if words_built != words_committed:
+        for i, (a, b) in enumerate(zip(words_built, words_committed)):
+            if a != b:
+                raise AssertionError(f"{what}: text differs near {a[:80]!r} vs {b[:80]!r} (after {i} numbers)")
+        raise AssertionError(f"{what}: {len(words_built) - 1} numbers built, {len(words_committed) - 1} committed")
+    for a, b in zip(_NUMBER.findall(built), _NUMBER.findall(committed)):
+        if not math.isclose(float(a), float(b), rel_tol=rtol, abs_tol=atol):
+            raise AssertionError(f"{what}: number {a} differs from the committed {b}")

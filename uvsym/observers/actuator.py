@@ -32,6 +32,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import ObserverError
+from uvsym.faults import ActuatorKind, actuator_kind
 from uvsym.models.model import Model
 
 __all__ = ["KINDS", "FORMS", "ActuatorObserver", "actuator_observer", "proportional_observer", "bias_observer",
@@ -81,7 +82,7 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
         raise ObserverError(f"unknown observer form {form!r}; known: {', '.join(FORMS)}")
     M = model.M
     coupled = not np.allclose(M, np.diag(np.diag(M)), rtol=0, atol=1e-12)
-    if require_assumption_1 and kind == "proportional" and form == "paper" and coupled:
+    if require_assumption_1 and actuator_kind(kind).scales and form == "paper" and coupled:
         raise ObserverError(f"{model.name}: the paper's proportional observer needs a diagonal mass matrix "
                             "(Assumption 1: CG = CB, symmetric vehicle); use form='momentum'")
     n = model.dof
@@ -91,13 +92,9 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
     tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
     T_d, K_mat = ca.diag(tau_d), ca.diag(K)
 
-    if kind == "proportional":
-        gain = ca.mtimes(M_inv, T_d) if form == "paper" else ca.mtimes(T_d, P)
-        R = -ca.mtimes(K_mat, ca.mtimes(gain, nu))
-        G, b = T_d, ca.SX.zeros(n)
-    else:
-        R = -ca.mtimes(K_mat, ca.mtimes(P, nu))
-        G, b = ca.SX.eye(n), (tau_d if kind == "bias" else ca.SX.zeros(n))
+    G, b, identity = _fault_action(actuator_kind(kind), T_d, tau_d)
+    gain = P if identity else (ca.mtimes(P, G) if form == "paper" else ca.mtimes(G, P))
+    R = -ca.mtimes(K_mat, ca.mtimes(gain, nu))
     L = ca.jacobian(R, nu)
     h = model.h(eta, nu)
     LM = ca.mtimes(L, M_inv)
@@ -121,6 +118,21 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
         error_dynamics=ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K], [e_dot],
                                    ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"], ["e_dot"]),
     )
+
+
+def _fault_action(fault: ActuatorKind, T_d, tau_d) -> tuple:
+    """(G, b, G is I) with ``tau = G f + b`` for the kind's ``deliver(tau_d, f) = (g0 + g1 f) tau_d + s0 + s1 f``:
+    ``G = g1 T_d + s1 I``, ``b = g0 tau_d + s0``; zero terms are left out and unit factors add no operation."""
+    (g0, g1), (s0, s1) = fault.gain, fault.shift
+    n = tau_d.numel()
+
+    def total(*terms):
+        present = [matrix if c == 1.0 else c * matrix for c, matrix in terms if c != 0.0]
+        return sum(present[1:], present[0]) if present else None
+
+    G = total((g1, T_d), (s1, ca.SX.eye(n)))
+    b = total((g0, tau_d), (s0, ca.SX.ones(n)))
+    return (ca.SX.zeros(n, n) if G is None else G), (ca.SX.zeros(n) if b is None else b), (g1, s1) == (0.0, 1.0)
 
 
 def proportional_observer(model: Model, form: str = "paper") -> ca.Function:
