@@ -25,8 +25,21 @@ def test_version():
 def test_models_json_lists_the_library(capsys):
     assert main(["models", "--json"]) == 0
     listing = json.loads(capsys.readouterr().out)
-    assert [v["name"] for v in listing] == uvsym.vehicle_names()
+    assert [v["name"] for v in listing if v["kind"] == "vehicle"] == uvsym.vehicle_names()
     assert {v["name"]: v["dof"] for v in listing}["otter3dof"] == 3
+    plants = {v["name"]: v for v in listing if v["kind"] == "plant"}
+    assert set(plants) == {"induction_motor", "quadrotor", "rov_yaw"}
+    assert plants["induction_motor"]["states"] == ["i_sq", "i_sd", "lambda_rq", "lambda_rd", "omega_m"]
+
+
+def test_models_show_a_plant_with_units_and_operating_point(capsys):
+    assert main(["models", "show", "induction_motor"]) == 0
+    out = capsys.readouterr().out
+    assert "omega_m (rad/s)" in out and "u_sq (V)" in out and "omega_m = 250" in out
+    assert "Rr" in out and "Ohm" in out and "Modelica" in out
+    assert main(["models", "show", "rov_yaw", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert [s["name"] for s in summary["outputs"]] == ["psi"] and summary["time"] == "continuous"
 
 
 def test_models_show_prints_parameters_with_units(capsys):

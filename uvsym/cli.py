@@ -17,6 +17,7 @@ from uvsym import __version__
 from uvsym.derivation import Derivation, derivation, load_derivations, observer_set, observer_sets
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
+from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["main"]
 
@@ -30,7 +31,11 @@ def _table(rows: list[list[str]], header: list[str]) -> str:
 def _cmd_models(args) -> int:
     if args.action == "show":
         if not args.name:
-            raise UnknownNameError(f"'uvsym models show' needs a vehicle name; known: {', '.join(VEHICLES)}")
+            raise UnknownNameError(f"'uvsym models show' needs a name; known: {', '.join(plant_names())}")
+        if args.name in PLANTS:
+            return _show_plant(plant(args.name), args.json)
+        if args.name not in VEHICLES:
+            raise UnknownNameError(f"unknown model {args.name!r}; known: {', '.join(plant_names())}")
         model = vehicle(args.name)
         summary = model.summary()
         if args.json:
@@ -44,16 +49,48 @@ def _cmd_models(args) -> int:
         print("equations: M (nu_dot - nu_c_dot) + h(eta, nu) = tau(eta, nu, u);  h = " + " + ".join(model.term_names))
         print(f"nu_dot: {model.nu_dot.n_instructions()} SX instructions\n")
         print("M =\n" + np.array2string(model.M, precision=6, suppress_small=True, max_line_width=140) + "\n")
-        rows = [[name, _format_value(p.value), p.unit, p.description] for name, p in model.parameters.items()]
-        print(_table(rows, ["parameter", "value", "unit", "meaning"]))
+        _parameter_table(model.parameters)
         return 0
-    listing = [{"name": name, "description": description, "dof": vehicle(name).dof,
-                "inputs": list(vehicle(name).input_labels)} for name, (description, _) in VEHICLES.items()]
+    listing = [{"name": name, "kind": "vehicle", "description": description, "dof": vehicle(name).dof,
+                "states": list(vehicle(name).state_labels), "inputs": list(vehicle(name).input_labels)}
+               for name, (description, _) in VEHICLES.items()]
+    listing += [{"name": name, "kind": "plant", "description": description, "dof": None,
+                 "states": list(plant(name).x.names), "inputs": list(plant(name).u.names)}
+                for name, (description, _) in PLANTS.items()]
     if args.json:
         print(json.dumps(listing, indent=2))
     else:
-        print(_table([[v["name"], v["dof"], ", ".join(v["inputs"]), v["description"]] for v in listing],
-                     ["name", "dof", "inputs", "description"]))
+        print(_table([[v["name"], v["dof"], ", ".join(v["inputs"]), v["description"]] for v in listing
+                      if v["kind"] == "vehicle"], ["vehicle", "dof", "inputs", "description"]) + "\n")
+        print(_table([[p["name"], _signals_line(plant(p["name"]).x), _signals_line(plant(p["name"]).u), p["description"]]
+                      for p in listing if p["kind"] == "plant"], ["plant", "states", "inputs", "description"]))
+    return 0
+
+
+def _signals_line(group) -> str:
+    return ", ".join(f"{name} ({unit})" for name, unit in zip(group.names, group.units)) or "none"
+
+
+def _parameter_table(parameters) -> None:
+    rows = [[name, _format_value(p.value), p.unit, p.description] for name, p in parameters.items()]
+    print(_table(rows, ["parameter", "value", "unit", "meaning"]))
+
+
+def _show_plant(system, as_json: bool) -> int:
+    """``uvsym models show PLANT``: signals with units, operating point, constants, source."""
+    if as_json:
+        print(json.dumps(system.summary(), indent=2))
+        return 0
+    print(f"{system.name}: {system.description}")
+    print("continuous time" if system.dt is None else f"discrete time, dt = {system.dt:g} s")
+    for label, group in (("states x", system.x), ("inputs u", system.u), ("disturbances d", system.d),
+                         ("parameters p", system.p), ("outputs y", system.y)):
+        print(f"{label}: {_signals_line(group)}")
+    print("operating point: " + ", ".join(f"{n} = {v:.6g}" for n, v in zip(system.x.names, system.x_op))
+          + "; " + ", ".join(f"{n} = {v:.6g}" for n, v in zip(system.u.names, system.u_op)))
+    print(f"f: {system.f.n_instructions()} SX instructions\nsource: {system.source}\n")
+    if system.constants is not None:
+        _parameter_table(system.constants)
     return 0
 
 
@@ -165,9 +202,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    models = sub.add_parser("models", help="list the vehicle library, or show one vehicle")
+    models = sub.add_parser("models", help="list the vehicles and plants, or show one")
     models.add_argument("action", nargs="?", choices=["list", "show"], default="list")
-    models.add_argument("name", nargs="?", help="vehicle name (with 'show')")
+    models.add_argument("name", nargs="?", help="vehicle or plant name (with 'show')")
     models.add_argument("--json", action="store_true", help="machine-readable output")
     models.set_defaults(run=_cmd_models)
     report = sub.add_parser("report", help="build derivation reports (all, or the ones named)")
