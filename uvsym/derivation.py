@@ -39,7 +39,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from uvsym.codegen.observer_sets import ObserverSet, make_observer_set
-from uvsym.errors import UnknownNameError, UvsymError
+from uvsym.errors import DerivationError, UnknownNameError
 
 if TYPE_CHECKING:
     from uvsym.verify.certificate import Certificate
@@ -48,10 +48,6 @@ __all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivat
            "observer_sets"]
 
 GROUP = "uvsym.derivations"
-
-
-class DerivationError(UvsymError, TypeError):
-    """An installed derivation is malformed: its entry point, or the Derivation it names."""
 
 
 @dataclass(frozen=True)

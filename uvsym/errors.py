@@ -18,6 +18,7 @@ __all__ = [
     "WiringError",
     "CodegenError",
     "VerificationError",
+    "DerivationError",
 ]
 
 
@@ -68,6 +69,10 @@ class CodegenError(UvsymError, RuntimeError):
 
 class VerificationError(UvsymError, ValueError):
     """A claim cannot be checked as posed (unsupported operation, malformed region, wrong sizes)."""
+
+
+class DerivationError(UvsymError, TypeError):
+    """An installed derivation is malformed: its entry point, or the Derivation it names."""
 
 
 class UnknownNameError(UvsymError, KeyError):

@@ -233,7 +233,8 @@ class ActuatorFault:
 
 @dataclass(frozen=True)
 class SensorFault:
-    """A fault on one measured state (index into x = [eta; nu]), in that state's unit.
+    """A fault on one measured output (index into the plant's outputs y; for a vehicle y = x =
+    [eta; nu]), in that output's unit.
 
     kind: a name in SENSOR_KINDS -- bias ``y + value``; drift ``y + value (t - onset)`` (value
     per second); stuck: the value measured at the last sample before onset; noise
@@ -280,7 +281,7 @@ def apply_sensor_faults(y, t, faults: tuple[SensorFault, ...], held, noise):
     parts = [y[i] for i in range(n)]
     latch = [y[i] for i in range(n)]
     for fault in faults:
-        _check_index(fault.channel, n, "state")
+        _check_index(fault.channel, n, "measured output")
         i, phi, kind = fault.channel, fault.profile.phi(t), fault.kind_object
         v = parts[i]
         target = kind.measure(v, fault.value, t, fault.profile.onset, held[i], noise[i])

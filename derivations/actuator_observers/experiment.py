@@ -22,11 +22,10 @@ from derivations.actuator_observers.figures import actuation_figure, estimates_f
 from derivations.actuator_observers.observer_sets import actuator_observers
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, DOCKING, PAPER, SECOND, TARGETS, TRUE
 from derivations.actuator_observers.report import report
-from uvsym.codegen.check import check_package
-from uvsym.errors import CodegenError
 from uvsym.observers.isolation import IsolationSettings
 from uvsym.observers.supervisor import FaultDiagnosis
 from uvsym.report import write_json
+from uvsym.report.sections import c_package, claim_rows
 from uvsym.sim.scenario import Scenario, load_scenario
 from uvsym.sim.simulation import scenario_observers, simulate_scenario
 
@@ -107,18 +106,10 @@ def _second_case(progress) -> dict:
 
 
 def _generated_c(scenario: Scenario, folder: Path) -> dict:
-    """Write the experiment's observers as a C package into ``folder``, compile it and compare with Python."""
+    """The experiment's observers as a checked C package in ``folder`` (:func:`uvsym.report.sections.c_package`)."""
     form = scenario.observers[0].form
-    observers = actuator_observers(vehicle=scenario.model.name, form=form)
-    manifest = observers.write(folder)
-    summary = {"package": observers.package_name, "folder": folder.name, "vehicle": scenario.model.name, "form": form,
-               "functions": [f["c_function"] for f in manifest["functions"]]}
-    try:
-        check = check_package(folder, list(observers.exported), observers.package_name)
-    except CodegenError as exc:
-        return summary | {"compiled": False, "reason": str(exc).splitlines()[0]}
-    return summary | {"compiled": True, "flags": " ".join(check.flags), "calls_per_function": check.calls,
-                      "max_relative_difference": check.max_relative_difference}
+    c = c_package(actuator_observers(vehicle=scenario.model.name, form=form), folder)
+    return {"package": c.pop("package"), "folder": c.pop("folder"), "vehicle": scenario.model.name, "form": form} | c
 
 
 def build(out_dir: Path, progress) -> None:
@@ -173,10 +164,7 @@ def build(out_dir: Path, progress) -> None:
     progress("C sources of the observers: write, compile, compare")
     results["c"] = _generated_c(scenario, out_dir / "c")
     progress("machine-checked claims")
-    results["claims"] = [{key: row[key] for key in ("claim", "set", "method", "status", "expected")}
-                         | {"margin": None if row["margin"] is None else float(f"{row['margin']:.3g}"),
-                            "counterexample": certificate.counterexample_summary()}
-                         for certificate, row in ((c, c.to_dict()) for c in core_paper_claims())]
+    results["claims"] = claim_rows(core_paper_claims())
     write_json(out_dir / "results.json", _round(results))
 
     progress("figures")

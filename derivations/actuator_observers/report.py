@@ -6,6 +6,7 @@ import casadi as ca
 
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
 from uvsym.report import markdown_table
+from uvsym.report.sections import c_section, claims_table, counterexamples
 from uvsym.sympy_bridge import latex
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import scenario_observers
@@ -30,35 +31,6 @@ def _derived_gains(scenario: Scenario) -> str:
                      f"derived along the faulty plant (constant $\\tau_d$):\n\n$$A_{{{kind[0]}}} = "
                      f"{latex(observer.error_matrix(tau_d, K), 4, zero_below=ROUNDING_SHOWN_AS_ZERO)}$$")
     return "\n\n".join(parts)
-
-
-def _claims_table(rows: list[dict]) -> str:
-    return markdown_table(["claim", "set", "method", "status", "expected", "margin"],
-                          [[r["claim"], r["set"], r["method"], f"**{r['status']}**" if r["status"] != r["expected"]
-                            else r["status"], r["expected"], "-" if r["margin"] is None else f"{r['margin']:.3g}"]
-                           for r in rows])
-
-
-def _counterexamples(rows: list[dict]) -> str:
-    return "\n".join(f"- {r['claim']}: {r['counterexample']}" for r in rows if r["counterexample"]) or "- none"
-
-
-def _c_section(c: dict) -> str:
-    """The report's section on the generated C package."""
-    package = c["folder"]
-    links = (f"[header](<{package}/include/{c['package']}.h>), [sources](<{package}/src/>), "
-             f"[Makefile](<{package}/Makefile>), [CMakeLists.txt](<{package}/CMakeLists.txt>), "
-             f"[example](<{package}/main.c>), [manifest](<{package}/manifest.json>)")
-    if c["compiled"]:
-        status = (f"Compiled by the run that wrote this report with `{c['flags']}` (no warnings), loaded back and "
-                  f"evaluated beside CasADi's own evaluation on {c['calls_per_function']} random calls per function: "
-                  f"largest relative difference {c['max_relative_difference']:.1g}.")
-    else:
-        status = f"**Not compiled by this run**: {c['reason']}"
-    functions = ", ".join(f"`{f}`" for f in c["functions"])
-    return (f"The observers of this experiment ({c['vehicle']}, {c['form']} form) as a C99 package in "
-            f"[`{package}/`](<{package}/>): {links}. Functions: {functions}; static work buffers, no allocation; "
-            f"build with `make` or CMake.\n\n{status}")
 
 
 def report(scenario: Scenario, r: dict, checks: dict) -> str:
@@ -162,16 +134,16 @@ arithmetic; the fault-tolerant loop of section 3.2 (uvsym's concrete loop: the 3
 graph. Negative controls are expected to be refuted; a refuted claim's counterexample is in
 `proofs.json` (`uvsym verify actuator-observers --json`).
 
-{_claims_table(r["claims"])}
+{claims_table(r["claims"])}
 
 Counterexamples of the refuted claims (the test suite substitutes each one back and checks that it
 violates its claim):
 
-{_counterexamples(r["claims"])}
+{counterexamples(r["claims"])}
 
 ## Generated C
 
-{_c_section(r["c"])}
+{c_section(r["c"], f"The observers of this experiment ({r['c']['vehicle']}, {r['c']['form']} form)")}
 
 ## Isolation per channel (run with correction)
 

@@ -91,8 +91,11 @@ def _wrapper(e: Exported, package: str) -> tuple[str, str]:
     """(prototype with its documentation, definition) of <package>_<function>."""
     f = e.function
     name, real = casadi_name(package, f.name()), f"{package}_real"
-    args = [f"const {real} {f.name_in(i)}[{f.nnz_in(i)}]" for i in range(f.n_in())]
-    args += [f"{real} {f.name_out(i)}[{f.nnz_out(i)}]" for i in range(f.n_out())]
+    # an empty argument (no entries) is a pointer, which may be NULL: ISO C has no zero-size arrays
+    args = [f"const {real} {f.name_in(i)}[{f.nnz_in(i)}]" if f.nnz_in(i) else f"const {real}* {f.name_in(i)}"
+            for i in range(f.n_in())]
+    args += [f"{real} {f.name_out(i)}[{f.nnz_out(i)}]" if f.nnz_out(i) else f"{real}* {f.name_out(i)}"
+             for i in range(f.n_out())]
     doc = [f"/* {e.description}", " *"]
     doc += [f" * in  {f.name_in(i)}[{f.nnz_in(i)}]: {e.input_units[i]}" for i in range(f.n_in())]
     doc += [f" * out {f.name_out(i)}[{f.nnz_out(i)}]: {e.output_units[i]}" for i in range(f.n_out())]
@@ -118,8 +121,8 @@ def _harness(functions: list[Exported], name: str) -> str:
         f = e.function
         reads = "\n".join(f"      for (i = 0; i < {f.nnz_in(k)}; ++i) if (scanf(\"%lf\", &v) != 1) return 1; "
                           f"else in{k}[i] = ({name}_real)v;" for k in range(f.n_in()))
-        declare = " ".join(f"{name}_real in{k}[{f.nnz_in(k)}];" for k in range(f.n_in()))
-        declare += " " + " ".join(f"{name}_real out{k}[{f.nnz_out(k)}];" for k in range(f.n_out()))
+        declare = " ".join(f"{name}_real in{k}[{max(1, f.nnz_in(k))}];" for k in range(f.n_in()))
+        declare += " " + " ".join(f"{name}_real out{k}[{max(1, f.nnz_out(k))}];" for k in range(f.n_out()))
         call = ", ".join([f"in{k}" for k in range(f.n_in())] + [f"out{k}" for k in range(f.n_out())])
         prints = "\n".join(f"      for (i = 0; i < {f.nnz_out(k)}; ++i) printf(\"%.17g \", (double)out{k}[i]);"
                            for k in range(f.n_out()))
@@ -154,8 +157,8 @@ int main(void) {{
 
 def _example(functions: list[Exported], name: str) -> str:
     f = functions[-1].function
-    declare = "\n".join(f"  {name}_real {f.name_in(i)}[{f.nnz_in(i)}] = {{0}};" for i in range(f.n_in()))
-    declare += "\n" + "\n".join(f"  {name}_real {f.name_out(i)}[{f.nnz_out(i)}];" for i in range(f.n_out()))
+    declare = "\n".join(f"  {name}_real {f.name_in(i)}[{max(1, f.nnz_in(i))}] = {{0}};" for i in range(f.n_in()))
+    declare += "\n" + "\n".join(f"  {name}_real {f.name_out(i)}[{max(1, f.nnz_out(i))}];" for i in range(f.n_out()))
     call = ", ".join([f.name_in(i) for i in range(f.n_in())] + [f.name_out(i) for i in range(f.n_out())])
     last = f.name_out(f.n_out() - 1)
     return f"""/* Example: one call of {name}_{f.name()} with zero inputs; prints its last output. */
