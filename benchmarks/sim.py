@@ -71,7 +71,7 @@ def main() -> dict:
     from uvsym.sim.closed_loop import build_closed_loop
 
     loop = build_closed_loop(scenario.model, scenario.controller, STEP,
-                             observers=observer_blocks(scenario.model, scenario.observers),
+                             observers=observer_blocks(scenario.model, scenario.observers, scenario.step),
                              actuator_faults=scenario.actuator_faults, current=scenario.current)
     fast_rate = runs["fast (compiled)"]["sim_s_per_wall_s"]
     return {

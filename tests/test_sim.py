@@ -241,7 +241,7 @@ def test_fault_signals_show_what_each_fault_does(docking):
 def test_observer_estimates_carry_the_unit_of_their_fault_kind(docking):
     from uvsym.sim.simulation import observer_blocks
 
-    units = {block.name: block.units for block in observer_blocks(docking.model, docking.observers)}
+    units = {obs.name: obs.publishes.units for obs in observer_blocks(docking.model, docking.observers, docking.step)}
     assert units == {"proportional": ("-",) * 6, "bias": ("N", "N", "N", "N m", "N m", "N m")}
 
 

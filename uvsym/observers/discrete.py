@@ -24,6 +24,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
+from uvsym.faults import actuator_kind
 from uvsym.models.model import Model
 from uvsym.observers.actuator import actuator_observer
 from uvsym.observers.base import Observer
@@ -134,7 +135,7 @@ def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "
     sampled = sampled_observer(continuous.function, dt)
     n = model.dof
     forces = Signals(FORCE_LABELS[n], model.force_units, group="force")
-    f_units = ("-",) * n if kind == "proportional" else model.force_units
+    f_units = tuple(map(actuator_kind(kind).unit, model.force_units))
     states = Signals(model.state_labels, model.state_units, group="measurement")
     name = name or kind
     s_names = tuple(f"{name}.s{i}" for i in range(sampled.state_size))

@@ -2,9 +2,10 @@
 closed loops of any System with blocks wired by signal name."""
 
 from uvsym.sim.blocks import Block, block, observer_block, renamed
-from uvsym.sim.closed_loop import ClosedLoop, ObserverBlock, build_closed_loop
+from uvsym.sim.closed_loop import ClosedLoop, build_closed_loop
 from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
 from uvsym.sim.feedback import lqr, lqr_gain, open_loop, pid, state_feedback
+from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.run import METHODS, Correction, Substitution, Supervisor
 from uvsym.sim.simulation import simulate
@@ -19,7 +20,7 @@ __all__ = [
     "Correction",
     "LineOfSight",
     "Loop",
-    "ObserverBlock",
+    "SampledLoop",
     "Signal",
     "SimResult",
     "Substitution",

@@ -15,72 +15,49 @@ so that an actuator's own lag is not mistaken for a fault.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
-import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
 from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
-from uvsym.observers.discrete import SampledObserver, sampled_observer
+from uvsym.observers.base import Observer
 from uvsym.sim.controllers import Autopilot
+from uvsym.sim.loop import SampledLoop
 from uvsym.symbolic import rk4
 
-__all__ = ["ObserverBlock", "ClosedLoop", "build_closed_loop"]
+__all__ = ["ClosedLoop", "build_closed_loop"]
 
 
-@dataclass(frozen=True)
-class ObserverBlock:
-    """An observer run in the loop: ``function(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``.
-
-    It runs in its sampled-data form (:mod:`uvsym.observers.discrete`) from ``f_hat = 0``.
-    ``K`` the gain entries; ``labels`` name the entries of ``f_hat`` and ``units`` their units.
-    """
-
-    name: str
-    function: ca.Function
-    K: np.ndarray
-    labels: tuple[str, ...]
-    units: tuple[str, ...]
-
-
-@dataclass(frozen=True)
-class ClosedLoop:
-    """Sizes, labels and Functions of one closed loop (see the module docstring for z and w).
-
-    discrete(z, w) -> (z_disc, u_cmd, out): z_disc the next [xc; xo; a_expected; held], out the
-    logged signals; plant_ode(s, u_cmd, env, t) -> s_dot for s = [x; a]; step(z, w) -> (z_next, out)
-    the fixed-step path (discrete part, then ``substeps`` RK4 steps of the plant). ``layout`` maps
-    the parts of z (x, a, xc, xo, a_expected, held) to their slices; ``sampled`` the observers'
-    sampled-data forms by name, ``observer_slices`` their states within xo. ``env_columns``,
-    ``correction_columns``: where w holds (V_c, beta_c) and (vec(S), o); no substitution channels.
+@dataclass(frozen=True, kw_only=True)
+class ClosedLoop(SampledLoop):
+    """The marine scenario loop (module docstring for z and w; the runner's fields in
+    :class:`~uvsym.sim.loop.SampledLoop`). ``layout`` maps x, a, xc, xo, a_expected, held to
+    their slices; ``observers`` the estimators by name, ``observer_slices`` their states within
+    xo. ``env_columns``, ``correction_columns``: where w holds (V_c, beta_c) and (vec(S), o).
     """
 
     model: Model
-    dt: float
-    substeps: int
-    n_z: int
-    n_w: int
-    n_s: int
-    discrete: ca.Function
-    plant_ode: ca.Function
-    step: ca.Function
-    layout: dict
     observer_slices: dict
-    sampled: dict[str, SampledObserver]
-    signals: dict  # name -> (slice of out, labels, units)
-    env_columns: slice
-    correction_columns: slice
-    substitution_columns: dict = field(default_factory=dict)
+    observers: dict[str, Observer]
+
+
+def _by_name(names: tuple[str, ...], available: dict, observer: str):
+    """The entries of ``available`` named ``names`` (SimulationError naming an unknown one)."""
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise SimulationError(f"observer {observer} reads {unknown}, which the loop does not have; "
+                              f"it has: {', '.join(available)}")
+    return [available[n] for n in names]
 
 
 def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                       actuator_faults: tuple[ActuatorFault, ...] = (),
                       sensor_faults: tuple[SensorFault, ...] = (),
-                      observers: tuple[ObserverBlock, ...] = (),
+                      observers: tuple[Observer, ...] = (),
                       substeps: int = 1, current: tuple[float, float] | None = None) -> ClosedLoop:
     """The closed loop of ``model`` under ``controller`` sampled every ``dt`` seconds.
 
@@ -94,8 +71,10 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     controller.check(model.input_labels, model.dof)
     n, m = 2 * model.dof, model.n_inputs
     n_c = len(controller.state_labels)
-    sampled = {obs.name: sampled_observer(obs.function, dt) for obs in observers}
-    n_o = sum(s.state_size for s in sampled.values())
+    for obs in observers:
+        if abs(obs.dt - dt) > 1e-12 * dt:
+            raise SimulationError(f"observer {obs.name} is sampled every {obs.dt:g} s, the loop every {dt:g} s")
+    n_o = sum(obs.state.size for obs in observers)
     layout, start = {}, 0
     for part, size in (("x", n), ("a", m), ("xc", n_c), ("xo", n_o), ("a_expected", m), ("held", n)):
         layout[part], start = slice(start, start + size), start + size
@@ -114,10 +93,13 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     tau_d = model.tau(eta_y, nu_y, a_expected, 0.0, 0.0)
     a_expected_next = rk4(lambda a, _t: model.actuator_rate(a, u_cmd), a_expected, dt, substeps)
 
+    measured = dict(zip(model.state_labels, ca.vertsplit(y)))
+    desired = {f"tau_d.{force}": tau_d[i] for i, force in enumerate(FORCE_LABELS[model.dof])}
     xo_next, estimates, observer_slices, start = [], [], {}, 0
     for obs in observers:
-        size = sampled[obs.name].state_size
-        s_next, f_hat = sampled[obs.name].step(xo[start:start + size], eta_y, nu_y, tau_d, ca.DM(obs.K))
+        size = obs.state.size
+        s_next, f_hat = obs.step(xo[start:start + size], ca.vertcat(*_by_name(obs.reads_y.names, measured, obs.name)),
+                                 ca.vertcat(*_by_name(obs.reads_u.names, desired, obs.name)), ca.DM(obs.p0))
         xo_next.append(s_next)
         estimates.append(f_hat)
         observer_slices[obs.name] = slice(start, start + size)
@@ -138,7 +120,8 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
         "reference": (refs, controller.reference_labels, controller.reference_units),
     }
     for obs, f_hat in zip(observers, estimates):
-        out_parts[f"f_hat/{obs.name}"] = (f_hat, obs.labels, obs.units)
+        out_parts[f"f_hat/{obs.name}"] = (f_hat, tuple(n.rsplit(".", 1)[-1] for n in obs.publishes.names),
+                                          obs.publishes.units)
     out = ca.vertcat(*[part[0] for part in out_parts.values()])
     signals, offset = {}, 0
     for name, (expr, labels, units) in out_parts.items():
@@ -162,5 +145,5 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                        ["z", "w"], ["z_next", "out"], {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
                       plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
-                      sampled=sampled, signals=signals, env_columns=slice(1 + n, 3 + n),
+                      observers={obs.name: obs for obs in observers}, signals=signals, env_columns=slice(1 + n, 3 + n),
                       correction_columns=slice(3 + n, n_w))

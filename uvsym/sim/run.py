@@ -27,9 +27,8 @@ import numpy as np
 from uvsym.codegen import compile_roll, find_compiler
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.observers.ftc import Correction
-from uvsym.sim.closed_loop import ClosedLoop
+from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
-from uvsym.sim.wiring import WiredLoop
 
 __all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop"]
 
@@ -60,7 +59,7 @@ class Supervisor(Protocol):
         """t: (k,) sample times (s); signals: name -> (k, n) values. Returns a new decision or None."""
 
 
-def run_closed_loop(loop: ClosedLoop | WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
+def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
                     compiled: bool = True, progress=None) -> tuple[SimResult, dict]:
     """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
@@ -101,7 +100,7 @@ def run_closed_loop(loop: ClosedLoop | WiredLoop, z0: np.ndarray, W: np.ndarray,
     return SimResult(W[:, 0].copy(), signals, {}), timing
 
 
-def _decision_columns(loop: ClosedLoop | WiredLoop, decision) -> tuple[slice | list[int], np.ndarray]:
+def _decision_columns(loop: SampledLoop, decision) -> tuple[slice | list[int], np.ndarray]:
     """Where in w a supervisor's decision goes and its values; SimulationError for one the loop cannot take."""
     if isinstance(decision, Correction) and loop.correction_columns is not None:
         return loop.correction_columns, np.concatenate([np.asarray(decision.S, float).reshape(-1, order="F"),
@@ -117,7 +116,7 @@ def _decision_columns(loop: ClosedLoop | WiredLoop, decision) -> tuple[slice | l
                           f"expected {'Correction' if loop.correction_columns is not None else 'Substitution'} or None")
 
 
-def _stepper(loop: ClosedLoop | WiredLoop, method: str, chunk: int, options: dict, compiled: bool):
+def _stepper(loop: SampledLoop, method: str, chunk: int, options: dict, compiled: bool):
     """(advance(z, W_rows, out_rows) -> z_end, seconds spent building); advance fills out_rows (k, n_out)."""
     started = time.perf_counter()
     if method == "fast":

@@ -6,11 +6,13 @@ import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
-from uvsym.faults import ActuatorFault, SensorFault, actuator_kind
+from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.models.model import Model
 from uvsym.observers import ActuatorObserver, actuator_observer
+from uvsym.observers.base import Observer
+from uvsym.observers.discrete import actuator_fault_observer
 from uvsym.observers.gains import design_gains
-from uvsym.sim.closed_loop import ObserverBlock, build_closed_loop
+from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.controllers import Autopilot
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, grid, run_closed_loop
@@ -22,7 +24,7 @@ __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observe
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
              actuators0=None, current=(0.0, 0.0),
              actuator_faults: tuple[ActuatorFault, ...] = (), sensor_faults: tuple[SensorFault, ...] = (),
-             observers: tuple[ObserverBlock, ...] = (), supervisor: Supervisor | None = None,
+             observers: tuple[Observer, ...] = (), supervisor: Supervisor | None = None,
              method: str = "fast", substeps: int = 1, seed: int = 0, options: dict | None = None,
              compiled: bool = True, progress=None) -> SimResult:
     """Simulate ``model`` under ``controller`` for ``duration`` s, sampled every ``dt`` s.
@@ -32,7 +34,8 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     eta0, nu0 : (dof,) initial position/attitude (m, rad) and velocity (m/s, rad/s).
     actuators0 : (m,) initial actuator values; default: the first command (no start-up transient).
     current : (V_c m/s, beta_c rad), or an (N + 1, 2) array with one row per sample.
-    observers : observers run in the loop in sampled-data form; each starts with ``f_hat = 0``.
+    observers : estimators (:class:`~uvsym.observers.base.Observer`, sampled every dt) run in the loop;
+        each reads measured states and ``tau_d.<force>`` by name and starts from ``init``.
     supervisor : discrete logic run every ``supervisor.period`` s that may correct the commands.
     method : ``fast`` (compiled fixed-step RK4 with ``substeps`` per sample) or a CasADi
         integrator plugin (``cvodes``, ``idas``, ``rk``, ``collocation``); ``options`` go to it.
@@ -69,10 +72,12 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     a0 = np.asarray(u_cmd0).ravel() if actuators0 is None else _vector(actuators0, m, "actuators0")
     z0[lay["a"]], z0[lay["a_expected"]] = a0, a0
     tau_d0 = np.asarray(model.tau(x0[:dof], x0[dof:], a0, 0.0, 0.0)).ravel()
+    measured = dict(zip(model.state_labels, x0))
+    desired = {f"tau_d.{force}": value for force, value in zip(FORCE_LABELS[dof], tau_d0)}
     for obs in observers:
         sl = loop.observer_slices[obs.name]
-        z0[lay["xo"].start + sl.start:lay["xo"].start + sl.stop] = loop.sampled[obs.name].initial_state(
-            x0[:dof], x0[dof:], tau_d0, obs.K)
+        z0[lay["xo"].start + sl.start:lay["xo"].start + sl.stop] = obs.initial_state(
+            [measured[n] for n in obs.reads_y.names], [desired[n] for n in obs.reads_u.names])
 
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
                                      compiled=compiled, progress=progress)
@@ -126,10 +131,10 @@ def current_profile(scenario: Scenario):
     return np.column_stack([speed, np.full(N + 1, scenario.current[1])])
 
 
-def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...]) -> tuple[ObserverBlock, ...]:
-    """The scenario's observers as blocks of the closed loop, named by their kind (f_hat in the kind's unit)."""
-    return tuple(ObserverBlock(kind, observer.function, K, FORCE_LABELS[model.dof],
-                               tuple(map(actuator_kind(kind).unit, model.force_units)))
+def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...], dt: float) -> tuple[Observer, ...]:
+    """The scenario's observers as :class:`~uvsym.observers.base.Observer` sampled every ``dt`` s,
+    named by their kind (f_hat in the kind's unit)."""
+    return tuple(actuator_fault_observer(model, kind, dt, K, form=observer.form, name=kind)
                  for kind, (observer, K) in scenario_observers(model, specs).items())
 
 
@@ -140,6 +145,6 @@ def simulate_scenario(scenario: Scenario, *, method: str = "fast", supervisor: S
                       eta0=scenario.eta0, nu0=scenario.nu0, actuators0=scenario.actuators0,
                       current=current_profile(scenario), actuator_faults=scenario.actuator_faults,
                       sensor_faults=scenario.sensor_faults,
-                      observers=observer_blocks(scenario.model, scenario.observers),
+                      observers=observer_blocks(scenario.model, scenario.observers, scenario.step),
                       supervisor=supervisor, method=method, seed=scenario.seed, progress=progress, **options)
     return SimResult(result.t, result.signals, {"scenario": scenario.name, **result.meta})

@@ -30,6 +30,7 @@ import numpy as np
 from uvsym.errors import WiringError
 from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
 from uvsym.sim.blocks import Block
+from uvsym.sim.loop import SampledLoop
 from uvsym.symbolic import rk4
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
@@ -40,39 +41,22 @@ RESERVED = ("x", "y", "u", "t", "held", "fault_sensor", "fault_actuator", "subst
 RAW = ".raw"
 
 
-@dataclass(frozen=True)
-class WiredLoop:
-    """A loop of a System and blocks, run by :func:`uvsym.sim.run.run_closed_loop`.
-
-    discrete(z, w) -> (z_disc, u_cmd, out): z_disc = z[n_s:] of the next sample, u_cmd the plant
-    inputs held over the sample, out the logged signals (``signals``: group -> (slice of out,
-    labels, units)); plant_ode(s, u_cmd, env, t) -> s_dot with s = x and env = d; step(z, w) ->
-    (z_next, out) the fixed-step path (``substeps`` RK4 steps per sample). reads(z, w) -> what
-    each block reads, one output per block (named by it); names: the published signals; units:
-    name -> unit; order: their evaluation order. layout: part of z (x, each block's name, held) -> slice; env_columns,
-    substitution_columns (channel -> column): where w holds d and the switches.
+@dataclass(frozen=True, kw_only=True)
+class WiredLoop(SampledLoop):
+    """A loop of a System and blocks (the runner's fields in :class:`~uvsym.sim.loop.SampledLoop`):
+    s = x, env = d; z = [x; each block's state; held]. reads(z, w) -> what each block reads, one
+    output per block (named by it); names: the published signals; units: name -> unit; order:
+    their evaluation order; layout: x, each block's name, held -> slice; substitution_columns:
+    channel -> the column of w holding its switch; no command correction.
     """
 
     plant: System
     blocks: tuple[Block, ...]
     p: np.ndarray
-    dt: float
-    substeps: int
-    n_z: int
-    n_w: int
-    n_s: int
-    discrete: ca.Function
-    plant_ode: ca.Function
-    step: ca.Function
     reads: ca.Function
     names: tuple[str, ...]
     units: dict[str, str]
     order: tuple[str, ...]
-    layout: dict[str, slice]
-    signals: dict
-    env_columns: slice
-    substitution_columns: dict[str, int]
-    correction_columns: slice | None = None
 
 
 def _column(items) -> ca.SX:
