@@ -17,6 +17,7 @@ from uvsym import __version__
 from uvsym.derivation import Derivation, derivation, load_derivations, observer_set, observer_sets
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
+from uvsym.paths import output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["main"]
@@ -62,7 +63,8 @@ def _cmd_models(args) -> int:
     else:
         print(_table([[v["name"], v["dof"], ", ".join(v["inputs"]), v["description"]] for v in listing
                       if v["kind"] == "vehicle"], ["vehicle", "dof", "inputs", "description"]) + "\n")
-        print(_table([[p["name"], _signals_line(plant(p["name"]).x), _signals_line(plant(p["name"]).u), p["description"]]
+        print(_table([[p["name"], _signals_line(plant(p["name"]).x), _signals_line(plant(p["name"]).u),
+                       p["description"]]
                       for p in listing if p["kind"] == "plant"], ["plant", "states", "inputs", "description"]))
     return 0
 
@@ -107,7 +109,7 @@ def _cmd_report(args) -> int:
     from uvsym.report.html import write_html
 
     selected = _selected(args.names)
-    out_root = Path(args.out)
+    out_root = output_folder(args.out, "reports")
     for index, study in enumerate(selected, 1):
         out_dir = out_root / study.name
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -160,13 +162,41 @@ def _cmd_codegen(args) -> int:
         return 0
     if not args.out:
         raise UvsymError(f"uvsym codegen {args.name}: give the output folder with -o/--out DIR")
+    factory = observer_sets().get(args.name, (None, None))[1]
     options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
+    options |= _set_options(args.name, factory, args.set_options)
     observers = observer_set(args.name, **options)
     manifest = observers.write(args.out, "float" if args.float else "double")
-    print(f"wrote {args.out}: {observers.package_name}, {len(manifest['functions'])} functions "
+    count = len(manifest["functions"])
+    print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "
           f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
           f"build with 'make' or cmake")
     return 0
+
+
+def _set_options(name: str, factory, tokens: list[str]) -> dict:
+    """``--key value`` / ``--key=value`` options of an observer set, typed like the factory's defaults."""
+    import inspect
+
+    options, tokens = {}, list(tokens)
+    while tokens:
+        token = tokens.pop(0)
+        if not token.startswith("--") or len(token) < 3:
+            raise UvsymError(f"uvsym codegen {name}: unexpected argument {token!r}")
+        key, _, value = token[2:].partition("=")
+        if not _ and not tokens:
+            raise UvsymError(f"uvsym codegen {name}: option --{key} needs a value")
+        value = value if _ else tokens.pop(0)
+        key = key.replace("-", "_")
+        parameter = inspect.signature(factory).parameters.get(key) if factory else None
+        default = None if parameter is None else parameter.default
+        try:
+            options[key] = type(default)(value) if isinstance(default, (int, float)) and not isinstance(
+                default, bool) else value
+        except ValueError:
+            raise UvsymError(f"uvsym codegen {name}: option --{key} takes a {type(default).__name__}, "
+                             f"got {value!r}") from None
+    return options
 
 
 def _cmd_verify(args) -> int:
@@ -181,7 +211,7 @@ def _cmd_verify(args) -> int:
         certificates = study.claims()
         rows = [c.to_dict() for c in certificates]
         failures += sum(not c.as_expected for c in certificates)
-        out_dir = Path(args.out) / name
+        out_dir = output_folder(args.out, "proofs") / name
         out_dir.mkdir(parents=True, exist_ok=True)
         write_json(out_dir / "proofs.json", [{**row, "seconds": round(row["seconds"], 3)} for row in rows])
         everything += [{"derivation": name, **row} for row in rows]
@@ -222,7 +252,8 @@ def _parser() -> argparse.ArgumentParser:
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
     simulate.set_defaults(run=_cmd_simulate)
-    codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest)")
+    codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "
+                                             "a set's own options as --name value (uvsym codegen --list)")
     codegen.add_argument("name", nargs="?", help="observer set a derivation declares (none: list them)")
     codegen.add_argument("-o", "--out", help="output folder (needed with a set)")
     codegen.add_argument("--list", action="store_true", help="list the observer sets with their derivation")
@@ -240,7 +271,11 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``uvsym`` console script; returns the exit status."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra and args.command != "codegen":
+        parser.error(f"unrecognized arguments: {' '.join(extra)}")
+    args.set_options = extra
     try:
         return args.run(args)
     except UvsymError as exc:

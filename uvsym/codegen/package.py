@@ -34,6 +34,7 @@ from pathlib import Path
 import casadi as ca
 
 from uvsym.errors import CodegenError
+from uvsym.paths import output_folder
 
 __all__ = ["Exported", "PRECISIONS", "casadi_name", "write_package"]
 
@@ -240,7 +241,7 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     names = [_c_name(e.function.name()) for e in functions]
     if len(set(names)) < len(names):
         raise CodegenError(f"package {name}: function names must differ; given {', '.join(names)}")
-    out = Path(out_dir)
+    out = output_folder(out_dir, "the package", CodegenError)
     (out / "include").mkdir(parents=True, exist_ok=True)
     (out / "src").mkdir(exist_ok=True)
     # CasADi's internal symbols get the prefix <name>_casadi__, so they cannot meet an API name

@@ -36,7 +36,7 @@ import numpy as np
 from uvsym.errors import ObserverError
 from uvsym.systems.signals import Signals
 
-__all__ = ["Observer", "observer", "STEP_INPUTS", "STEP_OUTPUTS"]
+__all__ = ["Observer", "check_name", "observer", "STEP_INPUTS", "STEP_OUTPUTS"]
 
 STEP_INPUTS = ("s", "y", "u", "p")
 STEP_OUTPUTS = ("s_next", "out")
@@ -127,12 +127,21 @@ class Observer:
         return np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
 
 
+def check_name(name: str, what: str, error=ObserverError) -> None:
+    """``error`` unless ``name`` can name a CasADi and C function: a letter, then letters, digits
+    and single underscores."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z](_?[A-Za-z0-9])*", name):
+        raise error(f"{what} name {name!r} must start with a letter and hold only letters, digits and single "
+                    "underscores (it names C functions)")
+
+
 def observer(name: str, *, step: Callable, state: Signals, reads_y: Signals, reads_u: Signals,
              publishes: Signals, dt: float, params: Signals | None = None, p0=None, **options) -> Observer:
     """Build an :class:`Observer` from a Python callable ``step(s, y, u, p) -> (s_next, out)`` on SX.
 
     ``options`` go to :class:`Observer` (init, error_dynamics, equations, description).
     """
+    check_name(name, "observer")
     params = params if params is not None else Signals(group="parameter")
     s, y, u, p = (ca.SX.sym(a, g.size) for a, g in zip(STEP_INPUTS, (state, reads_y, reads_u, params)))
     result = step(s, y, u, p)
@@ -146,9 +155,6 @@ def observer(name: str, *, step: Callable, state: Signals, reads_y: Signals, rea
                    {v.name() for v in ca.symvar(ca.vertcat(s, y, u, p))})
     if stray:
         raise ObserverError(f"{name}: step uses symbols other than s, y, u, p: {stray}")
-    if not re.fullmatch(r"[A-Za-z](_?[A-Za-z0-9])*", name):
-        raise ObserverError(f"observer name {name!r} must start with a letter and hold only letters, digits and "
-                            "single underscores (it names C functions)")
     function = ca.Function(f"{name}_step", [s, y, u, p], [s_next, out], list(STEP_INPUTS), list(STEP_OUTPUTS))
     return Observer(name=name, step=function, state=state, reads_y=reads_y, reads_u=reads_u, params=params,
                     publishes=publishes, p0=np.zeros(params.size) if p0 is None else p0, dt=dt, **options)

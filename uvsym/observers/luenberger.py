@@ -27,7 +27,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import ObserverError
-from uvsym.observers.base import Observer, observer
+from uvsym.observers.base import Observer, check_name, observer
 from uvsym.symbolic import rk4
 from uvsym.systems.system import System
 
@@ -45,6 +45,7 @@ def luenberger_observer(plant: System, L, dt: float, *, name: str = "luenberger"
     ObserverError
         For a discrete plant, a gain of the wrong shape or with non-finite entries, or steps < 1.
     """
+    check_name(name, "observer")
     if plant.discrete:
         raise ObserverError(f"{name}: the Luenberger observer here is built on a continuous plant; "
                             f"{plant.name} is discrete (dt = {plant.dt} s)")

@@ -12,7 +12,6 @@ A unit left empty (``""``) is the unit of the signal it is joined to, filled in 
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
@@ -20,14 +19,13 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import WiringError
-from uvsym.observers.base import Observer
+from uvsym.observers.base import Observer, check_name
 from uvsym.systems.signals import Signals
 
 __all__ = ["Block", "block", "observer_block", "renamed", "as_signals"]
 
 STEP_INPUTS = ("s", "r")
 STEP_OUTPUTS = ("s_next", "out")
-NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 
 
 @dataclass(frozen=True)
@@ -52,9 +50,7 @@ class Block:
     description: str = ""
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not NAME.fullmatch(self.name):
-            raise WiringError(f"block name {self.name!r} must start with a letter and hold only letters, digits "
-                              "and underscores")
+        check_name(self.name, "block", WiringError)
         f = self.step
         if not isinstance(f, ca.Function) or tuple(f.name_in()) != STEP_INPUTS or \
                 tuple(f.name_out()) != STEP_OUTPUTS:
@@ -96,6 +92,7 @@ def block(name: str, *, step: Callable, state: Signals | None = None, reads=(), 
 
     reads, publishes: Signals, names or one name; state: Signals (default none); s0 default zeros.
     """
+    check_name(name, "block", WiringError)
     state = state if state is not None else Signals(group="state")
     reads, publishes = as_signals(reads, "read"), as_signals(publishes, "published")
     s, r = ca.SX.sym("s", state.size), ca.SX.sym("r", reads.size)

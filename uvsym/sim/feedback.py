@@ -31,9 +31,8 @@ def _one(spec, what: str) -> Signals:
     return group
 
 
-def pid(name: str, measured: str | Signals = "omega_m", reference: float | str = 0.0, *, kp: float,
-        ki: float = 0.0, kd: float = 0.0, output: str | Signals = "u_sq", limits: tuple[float, float] | None = None,
-        dt: float) -> Block:
+def pid(name: str, measured: str | Signals, reference: float | str = 0.0, *, output: str | Signals, kp: float,
+        ki: float = 0.0, kd: float = 0.0, limits: tuple[float, float] | None = None, dt: float) -> Block:
     """Discrete PID on one measured signal, derivative on the measurement, anti-windup by clamping.
 
     With e_k = r_k - y_k (r a constant or the loop signal named ``reference``)::

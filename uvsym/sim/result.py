@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import scipy.io
 
-from uvsym.errors import SimulationError
+from uvsym.errors import SimulationError, UnknownNameError
+from uvsym.paths import output_folder
 
 __all__ = ["Signal", "SimResult"]
 
@@ -33,7 +34,7 @@ class Signal:
     def __getitem__(self, label: str) -> np.ndarray:
         """The (N,) column of one entry, by label."""
         if label not in self.labels:
-            raise KeyError(f"no entry {label!r}; entries: {', '.join(self.labels)}")
+            raise UnknownNameError(f"no entry {label!r}; entries: {', '.join(self.labels)}")
         return self.values[:, self.labels.index(label)]
 
 
@@ -49,13 +50,14 @@ class SimResult:
 
     def __getitem__(self, name: str) -> Signal:
         if name not in self.signals:
-            raise KeyError(f"no signal {name!r}; signals: {', '.join(self.signals)}")
+            raise UnknownNameError(f"no signal {name!r}; signals: {', '.join(self.signals)}")
         return self.signals[name]
 
     def save(self, path) -> Path:
-        """Write to ``path``; the suffix (.npz, .csv or .mat) picks the format."""
+        """Write to ``path`` (its folder is made if missing); the suffix (.npz, .csv or .mat) picks the format."""
         path = Path(path)
         suffix = _suffix(path)
+        output_folder(path.parent, "the result", SimulationError).mkdir(parents=True, exist_ok=True)
         if suffix == ".npz":
             arrays = {"t": self.t, "meta": np.array(json.dumps(self.meta))}
             for name, sig in self.signals.items():

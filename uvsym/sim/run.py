@@ -83,8 +83,11 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
         k = min(chunk, N - start)
         z = advance(z, W[start:start + k], outputs[start:start + k])
         if not np.all(np.isfinite(z)):
-            raise SimulationError(f"state became non-finite between t = {start * loop.dt:.6g} s and "
-                                  f"t = {(start + k) * loop.dt:.6g} s ({method}); try a smaller step")
+            bad = np.flatnonzero(~np.all(np.isfinite(outputs[start:start + k]), axis=1))
+            first = start + (bad[0] if bad.size else k)
+            raise SimulationError(f"the loop diverged: its signals are non-finite from t = {first * loop.dt:.6g} s "
+                                  f"({method}); look for an unstable loop (gains, signs), a model that gives NaN "
+                                  "there, or too large a step")
         if supervisor is not None:
             signals = {name: outputs[start:start + k, sl] for name, (sl, _, _) in loop.signals.items()}
             decision = supervisor.update(W[start:start + k, 0], signals)

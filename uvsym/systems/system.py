@@ -147,6 +147,8 @@ class System:
                 "time": "continuous" if self.dt is None else f"discrete, dt = {self.dt:g} s",
                 "states": self.x.to_list(), "inputs": self.u.to_list(), "disturbances": self.d.to_list(),
                 "parameters": self.p.to_list(), "outputs": self.y.to_list(), "p0": self.p0.tolist(),
+                "operating_point": {"x": dict(zip(self.x.names, self.x_op.tolist())),
+                                    "u": dict(zip(self.u.names, self.u_op.tolist()))},
                 "constants": constants, "source": self.source,
                 "sx_instructions": {"f": self.f.n_instructions()}}
 
@@ -167,6 +169,15 @@ def _check_function(name: str, function, inputs: tuple, sizes: dict, outputs: di
         if function.numel_out(i) != size:
             raise ModelError(f"{name}: {function.name()} output {out} has {function.numel_out(i)} entries, "
                              f"expected {size}")
+
+
+def _expression(name: str, what: str, value) -> ca.SX:
+    """An SX column from what a user's rhs/output returned (SX, a list of SX and numbers, ...)."""
+    try:
+        return ca.vec(ca.vertcat(*value) if isinstance(value, (list, tuple)) else ca.SX(value))
+    except (NotImplementedError, TypeError, RuntimeError):
+        raise ModelError(f"{name}: {what} must return a CasADi expression or a list of them, "
+                         f"got {type(value).__name__}") from None
 
 
 def system(name: str, description: str, *, x: Signals, u: Signals, rhs: Callable,
@@ -191,8 +202,8 @@ def system(name: str, description: str, *, x: Signals, u: Signals, rhs: Callable
         raise ModelError(f"{name}: an output function needs its output signals y")
     syms = [ca.SX.sym(a, s.size) for a, s in zip(ARGUMENTS, (x, u, d, p))]
     xs, us, ds, ps = syms
-    rhs_expr = ca.SX(rhs(xs, us, ds, ps))
-    out_expr = ca.SX(xs if output is None else output(xs, us, ps))
+    rhs_expr = _expression(name, "rhs", rhs(xs, us, ds, ps))
+    out_expr = _expression(name, "output", xs if output is None else output(xs, us, ps))
     for what, expr, size in (("rhs", rhs_expr, x.size), ("output", out_expr, y.size)):
         if expr.numel() != size:
             raise ModelError(f"{name}: {what} gives {expr.numel()} entries (shape {expr.shape}), expected {size}")
@@ -201,6 +212,12 @@ def system(name: str, description: str, *, x: Signals, u: Signals, rhs: Callable
     stray = sorted({s.name() for s in free} - known)
     if stray:
         raise ModelError(f"{name}: the equations use symbols other than x, u, d, p: {stray}")
+    for what, expr in (("rhs", rhs_expr), ("output", out_expr)):
+        graph = ca.Function("graph", syms, [expr], {"allow_free": True})
+        if any(graph.instruction_id(k) == ca.OP_CONST and np.isnan(graph.instruction_constant(k))
+               for k in range(graph.n_instructions())):
+            raise ModelError(f"{name}: the {what} holds a NaN constant: a math or numpy function applied to a "
+                             "CasADi symbol gives NaN; use casadi's own (ca.sin, ca.exp, ...)")
     out_name = "x_dot" if dt is None else "x_next"
     f = ca.Function("f" if dt is None else "f_d", syms, [ca.vec(rhs_expr)], list(ARGUMENTS), [out_name])
     h = ca.Function("h", [xs, us, ps], [ca.vec(out_expr)], ["x", "u", "p"], ["y"])

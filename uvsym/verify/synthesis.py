@@ -10,6 +10,7 @@ independently of the solver.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -19,7 +20,9 @@ from uvsym.errors import UvsymError
 from uvsym.verify.certificate import Certificate
 from uvsym.verify.lyapunov import lyapunov_decrease
 
-__all__ = ["GainSynthesis", "synthesize_observer_gain"]
+__all__ = ["DESIGN_MARGIN", "GainSynthesis", "synthesize_observer_gain"]
+
+DESIGN_MARGIN = 1.01  # the LMI asks for 1 % more than the rate certified
 
 
 @dataclass(frozen=True)
@@ -35,21 +38,39 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
                              claim: str = "observer error decays") -> GainSynthesis:
     """A gain L with ``e' = (A - L C) e`` decaying at rate ``decay`` (1/s), by LMI, then certified.
 
-    equalities: optional list of callables ``(P, Y) -> cvxpy constraint`` (e.g. unknown-input
-    decoupling). Raises UvsymError when the LMI has no solution.
+    The LMI is solved for ``DESIGN_MARGIN`` times the rate, so that the gain is certified at the
+    rate asked for with room to spare (the optimum otherwise sits on the boundary, where the
+    exact re-check can go either way). equalities: optional list of callables
+    ``(P, Y) -> cvxpy constraint`` (e.g. unknown-input decoupling).
+
+    Raises
+    ------
+    UvsymError
+        For non-finite or wrongly sized A or C, a decay that is negative or not finite, an LMI
+        without a solution, or a gain that the exact re-check cannot certify.
     """
     A, C = np.atleast_2d(np.asarray(A, dtype=float)), np.atleast_2d(np.asarray(C, dtype=float))
     n, p = A.shape[0], C.shape[0]
     if A.shape != (n, n) or C.shape[1] != n:
         raise UvsymError(f"A must be square and C have {n} columns; got A {A.shape}, C {C.shape}")
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(C))):
+        raise UvsymError("A and C must be finite")
+    if not (np.isfinite(decay) and decay >= 0):
+        raise UvsymError(f"decay must be a finite rate >= 0 (1/s), got {decay}")
     P, Y = cp.Variable((n, n), symmetric=True), cp.Variable((n, p))
-    M = A.T @ P + P @ A - C.T @ Y.T - Y @ C + 2 * decay * P
+    design = DESIGN_MARGIN * decay + 1e-6
+    M = A.T @ P + P @ A - C.T @ Y.T - Y @ C + 2 * design * P
     constraints = [P >> np.eye(n), 0.5 * (M + M.T) << -1e-6 * np.eye(n)]
     constraints += [make(P, Y) for make in (equalities or [])]
     problem = cp.Problem(cp.Minimize(cp.trace(P) + cp.norm(Y, "fro")), constraints)
-    problem.solve(solver=cp.CLARABEL)
+    with warnings.catch_warnings():  # an inaccurate solution is re-checked exactly below
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+        problem.solve(solver=cp.CLARABEL)
     if P.value is None or problem.status not in ("optimal", "optimal_inaccurate"):
         raise UvsymError(f"no observer gain with decay {decay} 1/s: the LMI is {problem.status}")
     L = np.linalg.solve(P.value, Y.value)
     certificate = lyapunov_decrease(claim, [A - L @ C], decay, f"A - L C with the synthesised L, decay {decay:g} 1/s")
+    if certificate.status != "proved":
+        raise UvsymError(f"the synthesised gain could not be certified at decay {decay:g} 1/s "
+                         f"({certificate.status}: {certificate.reason or certificate.method})")
     return GainSynthesis(L=L, P=np.asarray(P.value), certificate=certificate)
