@@ -41,7 +41,8 @@ def main() -> dict:
   int k;
   for (k = 0; k < 18; ++k) K[k] = 1.0;"""
         step_ns = c_loop_ns([folder / "src" / f"{name}_casadi.c", folder / "src" / f"{name}.c"], folder / "include",
-                            f"{name}.h", setup, f"{name}_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat)",
+                            f"{name}.h", setup,
+                            f"{name}_actuator_observers_step(x, eta, nu, tau, K, dt, x_next, f_hat)",
                             "nu[0]", 1.5, "f_hat[0]")
     args = [np.zeros(18), np.array([0, 0, 5, 0.01, 0.02, 0.3]), np.array([1.5, 0.1, 0.02, 0.01, 0.01, 0.02]),
             np.array([10, 1, 2, 0.1, 1, 0.5]), np.ones(18), np.array([0.01])]

@@ -55,3 +55,33 @@ def test_claims_reject_observers_without_error_dynamics():
     obs = luenberger_observer(plant, L, 0.01)
     with pytest.raises(VerificationError, match="P must be 2x2"):
         region_decay_claim(obs, plant, np.eye(3), 0.1, [0.1, 0.1], 0.01)
+
+
+def _bilinear():
+    """x1' = -x1 + x1 x2 + u, x2' = -2 x2 + x1^2, y = x1: polynomial of degree 2."""
+    return system("bilinear", "quadratic plant", x=signals(("a", "-"), ("b", "-"), group="state"),
+                  u=signals(("u", "-"), group="input"), y=signals(("a_meas", "-"), group="output"),
+                  rhs=lambda x, u, d, p: ca.vertcat(-x[0] + x[0] * x[1] + u[0], -2 * x[1] + x[0] ** 2),
+                  output=lambda x, u, p: x[0], x_op=[0.5, 0.125], u_op=[0.5 - 0.5 * 0.125])
+
+
+def test_quadratic_error_dynamics_are_expanded_exactly_and_proved_on_a_box():
+    from uvsym.verify.estimators import _quadratic_form
+
+    plant = _bilinear()
+    assert np.allclose(np.asarray(plant.f(plant.x_op, plant.u_op, [], [])).ravel(), 0.0, atol=1e-15)
+    gain = np.array([[3.0], [0.0]])
+    obs = luenberger_observer(plant, gain, 0.01)
+    e = ca.SX.sym("e", 2)
+    direct = obs.error_dynamics(e, plant.x_op, plant.u_op, np.zeros(0), np.zeros(0))
+    expanded = _quadratic_form(direct, e)
+    compare = ca.Function("compare", [e], [direct, expanded])
+    for point in np.random.default_rng(3).uniform(-2, 2, size=(20, 2)):
+        a, b = (np.asarray(v).ravel() for v in compare(point))
+        np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12)
+    lin = plant.linearize()
+    P = scipy.linalg.solve_continuous_lyapunov((lin.A - gain @ lin.C).T, -np.eye(2))
+    assert_proved(region_decay_claim(obs, plant, P, gamma=0.1, half_widths=[0.2, 0.2], cube=0.02))
+    # too large a box: the quadratic terms win somewhere, and the verifier says where
+    far = region_decay_claim(obs, plant, P, gamma=0.1, half_widths=[5.0, 5.0], cube=0.02, expected="refuted")
+    assert_refuted(far)

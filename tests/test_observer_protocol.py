@@ -1,4 +1,4 @@
-"""The estimator contract: Observer validation, the actuator observers and the Luenberger observer as implementations."""
+"""The estimator contract: Observer validation; the actuator and Luenberger observers implement it."""
 
 import casadi as ca
 import numpy as np
@@ -7,10 +7,10 @@ from scipy.linalg import expm
 
 import uvsym
 from uvsym.errors import ModelError, ObserverError
+from uvsym.observers.actuator import actuator_observer
 from uvsym.observers.base import Observer, observer
 from uvsym.observers.discrete import actuator_fault_observer, sampled_observer
 from uvsym.observers.luenberger import luenberger_observer
-from uvsym.observers.actuator import actuator_observer
 from uvsym.systems import Signals, signals, system
 
 X = signals(("pos", "m", "position"), ("vel", "m/s", "velocity"), group="state")

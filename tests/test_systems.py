@@ -173,13 +173,13 @@ def test_quadrotor_inertias_reproduce_config_hover():
 
 def test_quadrotor_linearization_has_the_hover_structure():
     lin = plant("quadrotor").linearize()
-    l, Kf, Kt, m = 0.19685, 0.1188, 0.0036, 2.85
-    Jp = 2 * (1.91e-6 + m / 4 * l**2)
+    arm, Kf, Kt, m = 0.19685, 0.1188, 0.0036, 2.85
+    Jp = 2 * (1.91e-6 + m / 4 * arm**2)
     A = np.zeros((8, 8))
     A[0, 3] = A[1, 4] = A[2, 5] = A[6, 7] = 1.0
     B = np.zeros((8, 4))
-    B[3] = l * Kf / Jp * np.array([0, 0, -1, 1])      # roll: left minus right
-    B[4] = l * Kf / Jp * np.array([1, -1, 0, 0])      # pitch: front minus back (Quanser's pitch row)
+    B[3] = arm * Kf / Jp * np.array([0, 0, -1, 1])      # roll: left minus right
+    B[4] = arm * Kf / Jp * np.array([1, -1, 0, 0])      # pitch: front minus back (Quanser's pitch row)
     B[5] = Kt / (2 * Jp) * np.array([1, 1, -1, -1])   # yaw: Jy = 2 Jp
     B[7] = -Kf / m
     E = np.zeros((8, 1))

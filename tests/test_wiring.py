@@ -8,6 +8,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 import pytest
+from problems import DT, double_integrator, first_order, integrator
 
 from uvsym.errors import WiringError
 from uvsym.faults import ActuatorFault, Profile, SensorFault
@@ -16,8 +17,6 @@ from uvsym.sim import (
     Substitution,
     block,
     interconnect,
-    lqr,
-    lqr_gain,
     observer_block,
     open_loop,
     pid,
@@ -26,34 +25,6 @@ from uvsym.sim import (
     state_feedback,
 )
 from uvsym.systems import signals, system
-
-DT = 0.01
-
-
-def double_integrator(outputs=("pos", "vel")):
-    """pos' = vel, vel' = acc; y the named states."""
-    x = signals(("pos", "m"), ("vel", "m/s"), group="state")
-    picked = x.indices(outputs)
-    return system("double_integrator", "pos'' = acc", x=x, u=signals(("acc", "m/s^2"), group="input"),
-                  rhs=lambda x, u, d, p: ca.vertcat(x[1], u[0]), y=x.select(outputs).renamed(group="output"),
-                  output=lambda x, u, p: ca.vertcat(*[x[i] for i in picked]))
-
-
-def first_order(a=0.5, b=2.0, gain=1.0):
-    """v' = -a v + b F (+ tau_d), y = m = gain v."""
-    return system("first_order", "v' = -a v + b F", x=signals(("v", "m/s"), group="state"),
-                  u=signals(("F", "N"), group="input"), d=signals(("tau_d", "N"), group="disturbance"),
-                  rhs=lambda x, u, d, p: -a * x + b * (u + d), y=signals(("m", "m/s"), group="output"),
-                  output=lambda x, u, p: gain * x)
-
-
-def integrator():
-    """q' = u, y = q."""
-    return system("integrator", "q' = u", x=signals(("q", "m"), group="state"),
-                  u=signals(("u", "m/s"), group="input"), rhs=lambda x, u, d, p: u)
-
-
-# -- closed-form responses ---------------------------------------------------------------------------------------
 
 
 def test_state_feedback_on_a_double_integrator_follows_the_exact_sampled_solution():
@@ -80,70 +51,6 @@ def test_first_order_plant_under_feedback_matches_the_exponential_and_cvodes_agr
     expected = per_sample ** np.arange(len(result.t))
     np.testing.assert_allclose(result["x"]["v"], expected, rtol=0, atol=1e-9)
 
-
-def test_pid_brings_a_first_order_plant_to_its_set_point_within_limits():
-    controller = pid("speed", measured="m", reference=1.0, kp=2.0, ki=1.5, output="F", limits=(-0.4, 0.4), dt=DT)
-    result = simulate_system(first_order(), [controller], duration=30.0, dt=DT, x0=[0.0])
-    assert abs(result["x"]["v"][-1] - 1.0) < 1e-4
-    assert result["speed"]["F"].max() <= 0.4 and result["speed"]["F"][0] == pytest.approx(0.4)
-    assert result["speed"]["F"][-1] == pytest.approx(0.25, abs=1e-4)  # holds a v = b F: F = 0.5 / 2
-
-
-def test_pid_clamps_its_integral_only_while_the_output_is_pushed_beyond_a_limit():
-    controller = pid("c", measured="y", reference=1.0, kp=1.0, ki=2.0, kd=0.5, output="u", limits=(-1.0, 1.0), dt=0.1)
-    # v = kp e + ki I - kd (y - y_prev) / dt; the new integral is I + e dt unless clamped
-    s_next, out = controller.step([3.0, 0.0], [0.0])  # e = 1, v = 1 + 6 - 0 = 7 > 1 and e > 0: held
-    np.testing.assert_allclose(np.asarray(s_next).ravel(), [3.0, 0.0])
-    assert float(out) == 1.0
-    s_next, out = controller.step([3.0, 2.2], [2.0])  # e = -1, v = -1 + 6 + 1 = 6 > 1 but e < 0: integrates
-    np.testing.assert_allclose(np.asarray(s_next).ravel(), [2.9, 2.0])
-    s_next, out = controller.step([0.1, 0.5], [0.5])  # e = 0.5, v = 0.5 + 0.2 = 0.7 within limits
-    np.testing.assert_allclose(np.asarray(s_next).ravel(), [0.15, 0.5])
-    assert float(out) == pytest.approx(0.7)
-    assert controller.initial_state([0.3]).tolist() == [0.0, 0.3]  # no derivative kick at the start
-
-
-@pytest.mark.parametrize("interpolation", ["previous", "linear"])
-def test_open_loop_table_drives_an_integrator(interpolation):
-    times, values = [0.5, 1.0, 2.0], [1.0, -1.0, 0.5]
-    table = open_loop("table", times, values, publishes=["u"], interpolation=interpolation)
-    result = simulate_system(integrator(), [table], duration=3.0, dt=DT, x0=[0.0])
-    t = result.t
-    if interpolation == "linear":
-        u = np.interp(t, times, values)
-    else:  # the last point at or before t, the first one before the table starts
-        u = np.asarray(values)[np.clip(np.searchsorted(times, t + 1e-9, side="right") - 1, 0, None)]
-    np.testing.assert_allclose(result["table"]["u"], u, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(result["x"]["q"], np.concatenate([[0.0], np.cumsum(u[:-1]) * DT]), atol=1e-12)
-
-
-def test_lqr_gain_of_a_double_integrator_is_the_closed_form():
-    A, B = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]])
-    # Q = I, R = 1: K = [1, sqrt(3)] (P = [[sqrt 3, 1], [1, sqrt 3]])
-    np.testing.assert_allclose(lqr_gain(A, B, np.eye(2), [[1.0]]), [[1.0, math.sqrt(3.0)]], rtol=1e-10)
-    Ad, Bd = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
-    P = np.eye(2)
-    for _ in range(5000):  # Riccati recursion to its fixed point
-        P = np.eye(2) + Ad.T @ P @ Ad - Ad.T @ P @ Bd @ np.linalg.solve(2.0 + Bd.T @ P @ Bd, Bd.T @ P @ Ad)
-    np.testing.assert_allclose(lqr_gain(Ad, Bd, np.eye(2), [[2.0]], dt=0.1),
-                               np.linalg.solve(2.0 + Bd.T @ P @ Bd, Bd.T @ P @ Ad), rtol=1e-9)
-
-
-def test_fast_path_and_cvodes_agree_on_a_nonlinear_plant_under_lqr():
-    pendulum = system("pendulum", "theta'' = -sin(theta) - 0.1 omega + tau",
-                      x=signals(("theta", "rad"), ("omega", "rad/s"), group="state"),
-                      u=signals(("tau", "1/s^2"), group="input"),
-                      rhs=lambda x, u, d, p: ca.vertcat(x[1], -ca.sin(x[0]) - 0.1 * x[1] + u[0]))
-    blocks = [lqr(pendulum, np.diag([10.0, 1.0]), [[1.0]], dt=DT)]
-    runs = {method: simulate_system(pendulum, blocks, duration=5.0, dt=DT, x0=[2.5, 0.0], method=method)
-            for method in ("fast", "cvodes")}
-    assert np.abs(runs["fast"]["x"].values - runs["cvodes"]["x"].values).max() < 1e-6
-    assert abs(runs["fast"]["x"]["theta"][-1]) < 1e-2  # and the loop is stable
-    interpreted = simulate_system(pendulum, blocks, duration=1.0, dt=DT, x0=[2.5, 0.0], compiled=False)
-    np.testing.assert_allclose(interpreted["x"].values, runs["fast"]["x"].values[:101], rtol=0, atol=1e-12)
-
-
-# -- observers -------------------------------------------------------------------------------------------------
 
 
 def luenberger(L, dt=DT):

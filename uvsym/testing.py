@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 from uvsym.verify.certificate import Certificate
 
-__all__ = ["assert_proved", "assert_refuted", "assert_same_text"]
+__all__ = ["assert_proved", "assert_refuted", "assert_same_folder", "assert_same_text"]
 
 
 def assert_proved(certificate: Certificate) -> None:
@@ -39,3 +40,20 @@ def assert_same_text(built: str, committed: str, rtol: float = 1e-6, atol: float
     for a, b in zip(_NUMBER.findall(built), _NUMBER.findall(committed)):
         if not math.isclose(float(a), float(b), rel_tol=rtol, abs_tol=atol):
             raise AssertionError(f"{what}: number {a} differs from the committed {b}")
+
+
+def assert_same_folder(built, committed, rtol: float = 1e-6, atol: float = 1e-9) -> None:
+    """:func:`assert_same_text` for every file under two folders, which must hold the same files.
+
+    A manifest's SHA-256 of a serialised Function moves with the last bit of its constants, so
+    ``"sha256"`` fields are not compared.
+    """
+    built, committed = Path(built), Path(committed)
+    files = sorted(p.relative_to(built) for p in built.rglob("*") if p.is_file())
+    expected = sorted(p.relative_to(committed) for p in committed.rglob("*") if p.is_file())
+    if files != expected:
+        raise AssertionError(f"{built} holds {[str(f) for f in files]}, {committed} holds {[str(f) for f in expected]}")
+    for relative in files:
+        texts = [re.sub(r'"sha256": "[0-9a-f]+"', '"sha256"', (root / relative).read_text())
+                 for root in (built, committed)]
+        assert_same_text(*texts, rtol=rtol, atol=atol, what=f"stale {relative}")

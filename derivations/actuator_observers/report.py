@@ -7,9 +7,9 @@ import casadi as ca
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
 from uvsym.report import markdown_table
 from uvsym.report.sections import c_section, claims_table, counterexamples
-from uvsym.sympy_bridge import latex
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import scenario_observers
+from uvsym.sympy_bridge import latex
 
 __all__ = ["report"]
 

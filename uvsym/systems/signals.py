@@ -67,7 +67,8 @@ class Signals:
         try:
             return self.names.index(name)
         except ValueError:
-            raise UnknownNameError(f"no {self.group} named {name!r}; known: {', '.join(self.names) or 'none'}") from None
+            known = ", ".join(self.names) or "none"
+            raise UnknownNameError(f"no {self.group} named {name!r}; known: {known}") from None
 
     def indices(self, names: Iterable[str]) -> list[int]:
         """Positions of several names, in the order given."""

@@ -9,8 +9,9 @@ that are exact anyway (sums whose TwoSum error is 0, and 0 * x, 0 / x) stay unwi
 an equilibrium evaluates to exactly 0. Library
 functions (exp, sin, tanh, ...) are accurate to within an ulp in glibc; they are widened by
 ``LIBM_ULPS`` units, except that the odd ones vanishing at 0 (sin, tanh, atan, sinh, asinh,
-expm1, log1p) give exactly 0 for an argument that is exactly 0 (IEEE signed zeros, exact). The enclosure is therefore rigorous: every value the function takes on a
-box lies between the bounds returned for it.
+expm1, log1p) give exactly 0 for an argument that is exactly 0 (IEEE signed zeros, exact).
+The enclosure is therefore rigorous: every value the function takes on a box lies between the
+bounds returned for it.
 
 ``smooth`` says, per box, whether no non-smooth operation (abs, min/max, comparisons,
 conditionals, sign, floor) has its kink inside the box; Taylor-type arguments need it.

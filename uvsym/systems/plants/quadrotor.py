@@ -67,13 +67,13 @@ def build(**overrides) -> System:
     p = load_parameters(NAME, PARAMETER_FILES, overrides)
     J = inertias(p)
     inertia = ca.DM([J["Jr"], J["Jp"], J["Jy"]])
-    m, g, l, Kf, Kt = (p.v(k) for k in ("m", "g", "l", "Kf", "Kt"))
+    m, g, arm, Kf, Kt = (p.v(k) for k in ("m", "g", "l", "Kf", "Kt"))
 
     def rhs(x, u, d, _p):
         phi, theta = x[0], x[1]
         omega = x[3:6]
         Vf, Vb, Vr, Vl = (u[i] for i in range(4))
-        tau = ca.vertcat(l * Kf * (Vl - Vr), l * Kf * (Vf - Vb), Kt * (Vf + Vb - Vr - Vl) + d[0])
+        tau = ca.vertcat(arm * Kf * (Vl - Vr), arm * Kf * (Vf - Vb), Kt * (Vf + Vb - Vr - Vl) + d[0])
         omega_dot = (tau - ca.cross(omega, inertia * omega)) / inertia
         w_dot = g - ca.cos(phi) * ca.cos(theta) * (m * g + Kf * (Vf + Vb + Vr + Vl)) / m
         return ca.vertcat(ca.mtimes(Tzyx(phi, theta), omega), omega_dot, x[7], w_dot)
