@@ -52,7 +52,8 @@ def run_cases() -> dict:
     residual = results["fault-free"][design().observer.name]["r_omega_m"]
     threshold = THRESHOLD_FACTOR * float(np.max(np.abs(residual[t >= CONVERGED_AFTER])))
     detection = {name: detection_time(result, threshold) for name, result in results.items()}
-    above = {name: float(np.count_nonzero(_alarms(result, threshold)) * (t[1] - t[0])) for name, result in results.items()}
+    above = {name: float(np.count_nonzero(_alarms(result, threshold)) * (t[1] - t[0]))
+             for name, result in results.items()}
     return {"results": results, "threshold": threshold, "detection_time_s": detection, "time_above_threshold_s": above}
 
 

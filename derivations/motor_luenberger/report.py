@@ -9,8 +9,16 @@ import numpy as np
 
 from derivations.motor_luenberger.claims import motor_claims
 from derivations.motor_luenberger.design import DECAY, design
-from derivations.motor_luenberger.experiment import (CONVERGED_AFTER, FAULT_ONSET, INCIPIENT_RATE, INITIAL_OFFSET, NOISE,
-                                                     SENSOR_GAIN, THRESHOLD_FACTOR, run_cases)
+from derivations.motor_luenberger.experiment import (
+    CONVERGED_AFTER,
+    FAULT_ONSET,
+    INCIPIENT_RATE,
+    INITIAL_OFFSET,
+    NOISE,
+    SENSOR_GAIN,
+    THRESHOLD_FACTOR,
+    run_cases,
+)
 from derivations.motor_luenberger.observer_sets import motor_luenberger
 from uvsym.report import latex_matrix, markdown_table, save_svg, write_json
 from uvsym.report.equations import observer_equations
@@ -64,7 +72,8 @@ def build(out_dir: Path, progress) -> None:
     progress("figures")
     _figure(cases, out_dir / "speed_residual.svg")
     results = {"decay_per_s": DECAY, "dt_s": d.observer.dt, "L": d.synthesis.L.tolist(),
-               "eigenvalues_A_minus_LC_real": sorted(np.linalg.eigvals(d.lin.A - d.synthesis.L @ d.lin.C).real.tolist()),
+               "eigenvalues_A_minus_LC_real": sorted(
+                   np.linalg.eigvals(d.lin.A - d.synthesis.L @ d.lin.C).real.tolist()),
                "threshold_rad_per_s": cases["threshold"], "detection_time_s": cases["detection_time_s"],
                "time_above_threshold_s": cases["time_above_threshold_s"],
                "estimation_rms": _estimation_errors(cases["results"]["fault-free"]), "c": c, "claims": claims}
