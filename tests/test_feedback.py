@@ -76,3 +76,12 @@ def test_fast_path_and_cvodes_agree_on_a_nonlinear_plant_under_lqr():
 
 
 # -- observers -------------------------------------------------------------------------------------------------
+
+
+def test_quick_look_of_a_wired_loop_shows_states_inputs_and_blocks(tmp_path):
+    controller = pid("c", measured="m", reference=1.0, kp=2.0, ki=1.0, output="F", dt=DT)
+    result = simulate_system(first_order(), [controller], duration=1.0, dt=DT, x0=[0.0])
+    figure = result.plot(tmp_path / "loop.svg")
+    titles = [ax.get_title(loc="left") for ax in figure.axes]
+    assert titles == ["x (m/s)", "u (N)", "c (N)"]
+    assert (tmp_path / "loop.svg").read_text().startswith("<?xml")

@@ -123,14 +123,20 @@ class SimResult:
         return cls(np.atleast_1d(data["t"]).astype(float), signals, json.loads(data["meta"]))
 
     def plot(self, path=None, names: tuple[str, ...] | None = None):
-        """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``."""
+        """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``.
+
+        Default signals: states, commands and fault estimates of a scenario run; states, inputs
+        and every block's published signals of a wired loop."""
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        names = names or tuple(n for n in ("x", "u_command", "u_actual") if n in self.signals) + tuple(
-            n for n in self.signals if n.startswith("f_hat/"))
+        if not names and "u_command" in self.signals:  # the marine scenario loop
+            names = tuple(n for n in ("x", "u_command", "u_actual") if n in self.signals) + tuple(
+                n for n in self.signals if n.startswith("f_hat/"))
+        elif not names:  # a wired loop: states, inputs and every block's signals
+            names = tuple(n for n in self.signals if n not in ("y", "fault_sensor", "fault_actuator", "substitution"))
         panels = []
         for name in names:
             sig = self[name]
