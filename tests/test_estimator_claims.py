@@ -10,7 +10,7 @@ from uvsym.observers.base import observer
 from uvsym.observers.luenberger import luenberger_observer
 from uvsym.systems import signals, system
 from uvsym.testing import assert_proved, assert_refuted
-from uvsym.verify.estimators import linear_decay_claim, linearisation_claim, region_decay_claim
+from uvsym.verify.estimators import linear_decay_claim, linearisation_claim, region_decay_claim, sampled_decay_claim
 
 X = signals(("angle", "rad"), ("rate", "rad/s"), group="state")
 L = np.array([[4.0], [5.0]])
@@ -31,8 +31,13 @@ def test_luenberger_claims_on_a_pendulum():
     lin = plant.linearize()
     slowest = -max(np.linalg.eigvals(lin.A - L @ lin.C).real)
     assert slowest > 1.0  # computed independently of the claim
-    assert_proved(linear_decay_claim(obs, lin, L, decay=0.9 * slowest))
-    assert_refuted(linear_decay_claim(obs, lin, L, decay=1.1 * slowest, expected="refuted"))
+    assert_proved(linear_decay_claim(obs, plant, decay=0.9 * slowest))
+    assert_refuted(linear_decay_claim(obs, plant, decay=1.1 * slowest, expected="refuted"))
+    # the claim is about the observer it names: without injection the pendulum's own rate (0.25) is too slow
+    assert_refuted(linear_decay_claim(luenberger_observer(plant, 0 * L, 0.01), plant, decay=1.0, expected="refuted"))
+    # sampled: exp(dt * eigenvalues) inside the unit circle at 0.01 s; far outside at 1 s
+    assert_proved(sampled_decay_claim(obs, plant))
+    assert_refuted(sampled_decay_claim(luenberger_observer(plant, L, 1.0), plant, expected="refuted"))
     A_cl = lin.A - L @ lin.C
     P = scipy.linalg.solve_continuous_lyapunov(A_cl.T, -np.eye(2))
     proved = region_decay_claim(obs, plant, P, gamma=0.1, half_widths=[0.3, 0.3], cube=0.05)
@@ -85,3 +90,28 @@ def test_quadratic_error_dynamics_are_expanded_exactly_and_proved_on_a_box():
     # too large a box: the quadratic terms win somewhere, and the verifier says where
     far = region_decay_claim(obs, plant, P, gamma=0.1, half_widths=[5.0, 5.0], cube=0.02, expected="refuted")
     assert_refuted(far)
+
+
+def test_region_claims_refuse_what_would_make_them_unsound():
+    plant = _pendulum()
+    obs = luenberger_observer(plant, L, 0.01)
+    with pytest.raises(VerificationError, match="positive definite"):
+        region_decay_claim(obs, plant, -np.eye(2), 0.1, [0.3, 0.3], 0.05)
+    with pytest.raises(VerificationError, match="not an equilibrium"):
+        region_decay_claim(obs, plant, np.eye(2), 0.1, [0.3, 0.3], 0.05, x0=[0.5, 0.0])
+
+
+def test_a_graph_with_floor_is_not_expanded_as_a_polynomial():
+    """floor has a structurally zero derivative: the expansion must not be used, and the claim
+    must not come out proved where V' > -gamma e'e (here at e = 0.5)."""
+    from uvsym.verify.estimators import _quadratic_form
+
+    plant = system("stepped", "x' = -x - 4 x floor(x)", x=signals(("a", "-"), group="state"),
+                   u=signals(("u", "-"), group="input"), rhs=lambda x, u, d, p: -x - 4 * x * ca.floor(x) + u)
+    obs = luenberger_observer(plant, [[1.0]], 0.01)
+    e = ca.SX.sym("e")
+    assert _quadratic_form(obs.error_dynamics(e, [0.0], [0.0], [], []), e) is None
+    e_dot = float(obs.error_dynamics(0.5, [0.0], [0.0], [], []))
+    assert 2 * 0.5 * e_dot + 0.1 * 0.25 > 0  # so "proved" would be false
+    certificate = region_decay_claim(obs, plant, np.eye(1), 0.1, [1.0], 0.05, expected="refuted")
+    assert certificate.status != "proved"

@@ -40,6 +40,9 @@ class Certificate:
     def counterexample_summary(self, digits: int = 3) -> str:
         """One line on what the counterexample shows ("" without one), numbers to ``digits`` digits."""
         example = self.counterexample or {}
+        if "eigenvalue_modulus" in example:
+            return (f"the sampled map has an eigenvalue of modulus {example['eigenvalue_modulus']:.{digits}g} "
+                    f">= {example['rho']:.{digits}g}")
         if "eigenvalue_real" in example:
             return (f"a vertex's eigenvalue has real part {example['eigenvalue_real']:.{digits}g} "
                     f"> -gamma = {0.0 - example['gamma']:.{digits}g}")

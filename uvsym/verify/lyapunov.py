@@ -16,10 +16,11 @@ from fractions import Fraction
 
 import cvxpy as cp
 import numpy as np
+from scipy.linalg import solve_discrete_lyapunov
 
 from uvsym.verify.certificate import Certificate
 
-__all__ = ["lyapunov_decrease", "exact_positive_definite"]
+__all__ = ["discrete_lyapunov_decrease", "lyapunov_decrease", "exact_positive_definite"]
 
 
 def exact_positive_definite(matrix: list[list[Fraction]]) -> tuple[bool, Fraction]:
@@ -86,3 +87,38 @@ def lyapunov_decrease(claim: str, vertices: list[np.ndarray], gamma: float, set_
                        status, expected, margin=float(min(margins)), seconds=time.perf_counter() - started,
                        reason="" if ok else "the solver's P failed the exact re-check",
                        details={"P": np.asarray(P.value).tolist()})
+
+
+def discrete_lyapunov_decrease(claim: str, Ad: np.ndarray, rho: float, set_description: str,
+                               expected: str = "proved") -> Certificate:
+    """Certificate that ``e_{k+1} = Ad e_k`` contracts at rate rho: ``V = e^T P e`` with
+    ``V_{k+1} <= rho^2 V_k``, i.e. ``P > 0`` and ``rho^2 P - Ad^T P Ad > 0`` (Stein inequality).
+
+    P solves ``(Ad / rho')^T P (Ad / rho') - P = -I`` (scipy) for rho' slightly above the spectral
+    radius, and is re-checked without the solver in exact rationals (LDL^T), as for the
+    continuous case. An eigenvalue of modulus >= rho refutes the claim (the counterexample).
+    """
+    started = time.perf_counter()
+    Ad = np.atleast_2d(np.asarray(Ad, dtype=float))
+    eigenvalues, vectors = np.linalg.eig(Ad)
+    k = int(np.argmax(np.abs(eigenvalues)))
+    radius = float(np.abs(eigenvalues[k]))
+    if radius >= rho:
+        return Certificate(claim, set_description, "eigenvalue of the sampled map", "refuted", expected,
+                           margin=rho - radius, seconds=time.perf_counter() - started,
+                           counterexample={"A": Ad.tolist(), "eigenvalue_modulus": radius, "rho": rho,
+                                           "eigenvector_real": vectors[:, k].real.tolist()})
+    scaled = Ad / (0.5 * (radius + rho))
+    P = solve_discrete_lyapunov(scaled.T, np.eye(Ad.shape[0]))
+    P_exact, A_exact = _rational(0.5 * (P + P.T)), _rational(Ad)
+    n, r2 = Ad.shape[0], Fraction(rho) ** 2
+    AtPA = [[sum(A_exact[k][i] * sum(P_exact[k][m] * A_exact[m][j] for m in range(n)) for k in range(n))
+             for j in range(n)] for i in range(n)]
+    ok_P, margin_P = exact_positive_definite(P_exact)
+    ok_S, margin_S = exact_positive_definite([[r2 * P_exact[i][j] - AtPA[i][j] for j in range(n)] for i in range(n)])
+    ok = ok_P and ok_S
+    return Certificate(claim, set_description, "discrete Lyapunov (Stein) inequality, P from scipy, re-checked by "
+                       "exact rational LDL^T", "proved" if ok else "inconclusive", expected,
+                       margin=float(min(margin_P, margin_S)), seconds=time.perf_counter() - started,
+                       reason="" if ok else "the solver's P failed the exact re-check",
+                       details={"spectral_radius": radius, "P": P.tolist()})

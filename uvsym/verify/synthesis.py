@@ -40,7 +40,8 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
 
     The LMI is solved for ``DESIGN_MARGIN`` times the rate, so that the gain is certified at the
     rate asked for with room to spare (the optimum otherwise sits on the boundary, where the
-    exact re-check can go either way). equalities: optional list of callables
+    exact re-check can go either way); where that is infeasible, at the rate itself.
+    equalities: optional list of callables
     ``(P, Y) -> cvxpy constraint`` (e.g. unknown-input decoupling).
 
     Raises
@@ -57,17 +58,21 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
         raise UvsymError("A and C must be finite")
     if not (np.isfinite(decay) and decay >= 0):
         raise UvsymError(f"decay must be a finite rate >= 0 (1/s), got {decay}")
-    P, Y = cp.Variable((n, n), symmetric=True), cp.Variable((n, p))
-    design = DESIGN_MARGIN * decay + 1e-6
-    M = A.T @ P + P @ A - C.T @ Y.T - Y @ C + 2 * design * P
-    constraints = [P >> np.eye(n), 0.5 * (M + M.T) << -1e-6 * np.eye(n)]
-    constraints += [make(P, Y) for make in (equalities or [])]
-    problem = cp.Problem(cp.Minimize(cp.trace(P) + cp.norm(Y, "fro")), constraints)
-    with warnings.catch_warnings():  # an inaccurate solution is re-checked exactly below
-        warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-        problem.solve(solver=cp.CLARABEL)
-    if P.value is None or problem.status not in ("optimal", "optimal_inaccurate"):
-        raise UvsymError(f"no observer gain with decay {decay} 1/s: the LMI is {problem.status}")
+    tried = []
+    for design in (DESIGN_MARGIN * decay + 1e-6, decay):  # with room to spare; else exactly the rate asked
+        P, Y = cp.Variable((n, n), symmetric=True), cp.Variable((n, p))
+        M = A.T @ P + P @ A - C.T @ Y.T - Y @ C + 2 * design * P
+        constraints = [P >> np.eye(n), 0.5 * (M + M.T) << -1e-6 * np.eye(n)]
+        constraints += [make(P, Y) for make in (equalities or [])]
+        problem = cp.Problem(cp.Minimize(cp.trace(P) + cp.norm(Y, "fro")), constraints)
+        with warnings.catch_warnings():  # an inaccurate solution is re-checked exactly below
+            warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+            problem.solve(solver=cp.CLARABEL)
+        tried.append(f"{design:.6g} 1/s: {problem.status}")
+        if P.value is not None and problem.status in ("optimal", "optimal_inaccurate"):
+            break
+    else:
+        raise UvsymError(f"no observer gain with decay {decay} 1/s: the LMI at {' and at '.join(tried)}")
     L = np.linalg.solve(P.value, Y.value)
     certificate = lyapunov_decrease(claim, [A - L @ C], decay, f"A - L C with the synthesised L, decay {decay:g} 1/s")
     if certificate.status != "proved":
