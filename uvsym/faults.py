@@ -31,6 +31,7 @@ __all__ = ["PROFILES", "ACTUATOR_KINDS", "SENSOR_KINDS", "ActuatorKind", "Sensor
            "Profile", "ActuatorFault", "SensorFault", "apply_actuator_faults", "apply_sensor_faults"]
 
 PROFILES = ("step", "ramp", "incipient", "intermittent")
+TIME_TOLERANCE = 1e-9  # s
 
 
 @dataclass(frozen=True)
@@ -182,8 +183,9 @@ class Profile:
         if self.kind not in PROFILES:
             raise FaultError(f"unknown fault profile {self.kind!r}; known: {', '.join(PROFILES)}")
         for name in ("onset", "end", "duration", "rate", "period", "duty"):
-            if math.isnan(getattr(self, name)):
-                raise FaultError(f"fault profile {name} is NaN")
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or math.isnan(value):
+                raise FaultError(f"fault profile {name} must be a number (s, 1/s or -), got {value!r}")
         if self.end <= self.onset:
             raise FaultError(f"fault profile end ({self.end} s) must be after its onset ({self.onset} s)")
         for name in ("duration", "rate", "period"):
@@ -192,20 +194,25 @@ class Profile:
         if not 0.0 < self.duty <= 1.0:
             raise FaultError(f"fault profile duty must be in (0, 1], got {self.duty}")
 
+    def active(self, t):
+        """True from onset until end (CasADi expression); a time within ``TIME_TOLERANCE`` of
+        either counts as at it, so that a sample k dt that rounds just below an onset is in."""
+        started = t - self.onset >= -TIME_TOLERANCE
+        return ca.logic_and(started, t < self.end - TIME_TOLERANCE) if math.isfinite(self.end) else started
+
     def phi(self, t):
         """phi(t) as a CasADi expression of t (SX/MX/DM or float)."""
-        s = t - self.onset
-        active = ca.logic_and(s >= 0, t < self.end) if math.isfinite(self.end) else s >= 0
+        s = ca.fmax(t - self.onset, 0.0)
         if self.kind == "step":
             shape = 1.0
         elif self.kind == "ramp":
             shape = ca.fmin(s / self.duration, 1.0)
         elif self.kind == "incipient":
-            shape = 1.0 - ca.exp(-self.rate * ca.fmax(s, 0.0))
+            shape = 1.0 - ca.exp(-self.rate * s)
         else:
             phase = s - self.period * ca.floor(s / self.period)
             shape = phase < self.duty * self.period
-        return ca.if_else(active, shape, 0.0)
+        return ca.if_else(self.active(t), shape, 0.0)
 
 
 @dataclass(frozen=True)
@@ -223,6 +230,7 @@ class ActuatorFault:
     profile: Profile = Profile()
 
     def __post_init__(self):
+        _check_index_type(self.actuator, "actuator")
         self.kind_object.check(self.value)
 
     @property
@@ -247,12 +255,18 @@ class SensorFault:
     profile: Profile = Profile()
 
     def __post_init__(self):
+        _check_index_type(self.channel, "channel")
         self.kind_object.check(self.value)
 
     @property
     def kind_object(self) -> SensorKind:
         """The :class:`SensorKind` named by ``kind``."""
         return sensor_kind(self.kind)
+
+
+def _check_index_type(index, what: str) -> None:
+    if isinstance(index, bool) or not isinstance(index, numbers.Integral):
+        raise FaultError(f"fault {what} must be an integer index (e.g. system.y.index(name)), got {index!r}")
 
 
 def _check_index(index: int, size: int, what: str) -> None:
@@ -286,6 +300,6 @@ def apply_sensor_faults(y, t, faults: tuple[SensorFault, ...], held, noise):
         v = parts[i]
         target = kind.measure(v, fault.value, t, fault.profile.onset, held[i], noise[i])
         if kind.latches:
-            latch[i] = ca.if_else(phi > 0, held[i], v)
+            latch[i] = ca.if_else(fault.profile.active(t), held[i], v)
         parts[i] = v + phi * (target - v)
     return ca.vertcat(*parts), ca.vertcat(*latch)

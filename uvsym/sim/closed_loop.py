@@ -120,8 +120,11 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
         "reference": (refs, controller.reference_labels, controller.reference_units),
     }
     for obs, f_hat in zip(observers, estimates):
-        out_parts[f"f_hat/{obs.name}"] = (f_hat, tuple(n.rsplit(".", 1)[-1] for n in obs.publishes.names),
-                                          obs.publishes.units)
+        labels = tuple(n.rsplit(".", 1)[-1] for n in obs.publishes.names)
+        if len(set(labels)) != len(labels):
+            raise SimulationError(f"observer {obs.name}: its published names {list(obs.publishes.names)} do not stay "
+                                  "apart once their '<quantity>.' prefix is dropped (this loop logs labels only)")
+        out_parts[f"f_hat/{obs.name}"] = (f_hat, labels, obs.publishes.units)
     out = ca.vertcat(*[part[0] for part in out_parts.values()])
     signals, offset = {}, 0
     for name, (expr, labels, units) in out_parts.items():

@@ -40,8 +40,10 @@ def pid(name: str, measured: str | Signals, reference: float | str = 0.0, *, out
         v_k = kp e_k + ki I_k - kd (y_k - y_{k-1}) / dt,     u_k = min(max(v_k, lo), hi)
         I_{k+1} = I_k + e_k dt, held while v_k is beyond a limit and ki e_k pushes further
 
-    State ``[I (unit of y times s), y_{k-1}]``, starting at ``[0, y_0]`` (no derivative kick).
-    Publishes u under ``output``; limits (lo, hi) in u's unit, None for none.
+    State ``[I (unit of y times s), y_{k-1}]``, starting at ``[0, y_0]`` (no derivative kick at the
+    start). A measurement substitution switched on mid-run is not bumpless: the derivative term
+    sees the step from the sensor to its substitute for one sample (use kd = 0, or read the raw
+    sensor, where that matters). Publishes u under ``output``; limits (lo, hi) in u's unit.
     """
     y_sig, u_sig = _one(measured, "measured"), _one(output, "output")
     lo, hi = (-np.inf, np.inf) if limits is None else (float(limits[0]), float(limits[1]))
@@ -69,9 +71,10 @@ def pid(name: str, measured: str | Signals, reference: float | str = 0.0, *, out
 
 
 def state_feedback(name: str, K, reads: Sequence[str] | Signals, x_ref=None, u_ref=None,
-                   publishes: Sequence[str] | Signals = ()) -> Block:
+                   publishes: Sequence[str] | Signals = (), dt: float | None = None) -> Block:
     """Static state feedback ``u = u_ref - K (x - x_ref)``: K (m, n), x read by the n names of
-    ``reads``, u published under the m names of ``publishes``; x_ref (n,), u_ref (m,) default 0."""
+    ``reads``, u published under the m names of ``publishes``; x_ref (n,), u_ref (m,) default 0;
+    dt: the sample period (s) K was designed for (a loop at another period refuses it), or None."""
     reads, publishes = as_signals(reads, "read"), as_signals(publishes, "published")
     K = np.atleast_2d(np.asarray(K, dtype=float))
     if K.shape != (publishes.size, reads.size) or not np.all(np.isfinite(K)):
@@ -80,7 +83,7 @@ def state_feedback(name: str, K, reads: Sequence[str] | Signals, x_ref=None, u_r
     x_ref = np.zeros(reads.size) if x_ref is None else reads.vector(x_ref, f"{name}: x_ref")
     u_ref = np.zeros(publishes.size) if u_ref is None else publishes.vector(u_ref, f"{name}: u_ref")
     return block(name, step=lambda s, r: (s, ca.DM(u_ref) - ca.mtimes(ca.DM(K), r - ca.DM(x_ref))),
-                 reads=reads, publishes=publishes, description="u = u_ref - K (x - x_ref)")
+                 reads=reads, publishes=publishes, dt=dt, description="u = u_ref - K (x - x_ref)")
 
 
 def lqr_gain(A, B, Q, R, dt: float | None = None) -> np.ndarray:
@@ -122,7 +125,7 @@ def lqr(system: System, Q, R, *, name: str = "lqr", dt: float | None = None, x_o
         (A, B), period = zoh_matrices(A, B, dt), dt
     K = lqr_gain(A, B, Q, R, period)
     return state_feedback(name, K, system.x if reads is None else reads, lin.x0, lin.u0,
-                          system.u if publishes is None else publishes)
+                          system.u if publishes is None else publishes, dt=period)
 
 
 def open_loop(name: str, t_table, u_table, publishes: Sequence[str] | Signals,
@@ -138,9 +141,12 @@ def open_loop(name: str, t_table, u_table, publishes: Sequence[str] | Signals,
                          f"{', '.join(INTERPOLATIONS)}")
     publishes = as_signals(publishes, "published")
     times = np.asarray(t_table, dtype=float).reshape(-1)
-    values = np.asarray(u_table, dtype=float).reshape(times.size, -1) if times.size else np.empty((0, 0))
-    if times.size == 0 or values.shape[1] != publishes.size or not np.all(np.isfinite(values)) or \
-            not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+    values = np.asarray(u_table, dtype=float)
+    if times.size == 0 or values.size != times.size * publishes.size:
+        raise ModelError(f"open loop {name}: needs one row of {publishes.size} value(s) per time; got {times.size} "
+                         f"times and a table of shape {values.shape}")
+    values = values.reshape(times.size, publishes.size)
+    if not np.all(np.isfinite(values)) or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
         raise ModelError(f"open loop {name}: needs finite, strictly increasing times and a (k, {publishes.size}) "
                          f"table for {list(publishes.names)}; got {times.size} times and shape {np.shape(u_table)}")
 

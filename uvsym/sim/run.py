@@ -71,7 +71,10 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
     N = W.shape[0] - 1
     if supervisor is not None:
-        chunk = max(1, round(supervisor.period / loop.dt))
+        period = getattr(supervisor, "period", None)
+        if not isinstance(period, (int, float)) or not (math.isfinite(period) and period > 0):
+            raise SimulationError(f"a supervisor needs a positive, finite period (s), got {period!r}")
+        chunk = max(1, round(period / loop.dt))
     else:
         chunk = CHUNK["fast" if method == "fast" else "integrator"]
     W = np.ascontiguousarray(W, dtype=float)

@@ -17,17 +17,19 @@ __all__ = ["simulate_system", "initial_state"]
 
 
 def initial_state(loop: WiredLoop, x0, w0: np.ndarray) -> np.ndarray:
-    """z0: plant state x0, each block's initial state (``init`` of its reads at t = 0, with every
-    block at its s0), and the stuck-sensor latch at the healthy outputs."""
+    """z0: plant state x0, the stuck-sensor latch at the healthy outputs, and each block's initial
+    state: ``init`` of its reads at t = 0. The inits are repeated once per block, so that a block
+    reading another block's output sees that block already initialised (a chain of any order)."""
     plant = loop.plant
     z0 = np.zeros(loop.n_z)
     z0[loop.layout["x"]] = plant.x.vector(x0, f"{plant.name}: x0")
     for b in loop.blocks:
         z0[loop.layout[b.name]] = b.s0
-    for b, r0 in zip(loop.blocks, loop.reads.call([z0, w0])):  # call: a list even for one block
-        z0[loop.layout[b.name]] = b.initial_state(np.asarray(r0).ravel())
     out = np.asarray(loop.discrete(z0, w0)[2]).ravel()
     z0[loop.layout["held"]] = out[loop.signals["y"][0]] - out[loop.signals["fault_sensor"][0]]
+    for _ in loop.blocks:
+        for b, r0 in zip(loop.blocks, loop.reads.call([z0, w0])):  # call: a list even for one block
+            z0[loop.layout[b.name]] = b.initial_state(np.asarray(r0).ravel())
     return z0
 
 

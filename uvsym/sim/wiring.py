@@ -14,9 +14,11 @@ the plant's disturbances, and one switch (0 or 1) per substitution channel. At e
 
 in the order the outputs depend on each other; the plant inputs u_k are held over the sample
 while ``x' = f(x, u_f(u_k, t), d_k, p)`` is integrated, with actuator faults u_f in continuous
-time. Measurement substitution ``{"psi": "psi_hat"}``: while channel psi is on, every block that
-reads ``psi`` gets ``psi_hat`` instead, except the block publishing ``psi_hat`` (an estimator
-keeps seeing its sensor); switches are columns of w, set by a supervisor's ``Substitution``.
+time (the fixed-step RK4 path smears a fault that switches inside a sample over that sample;
+the CasADi integrators, or onsets on the sample grid, avoid it). Measurement substitution
+``{"psi": "psi_hat"}``: while channel psi is on, every block that reads ``psi`` gets ``psi_hat``
+instead, except the block publishing ``psi_hat`` (an estimator keeps seeing its sensor); switches
+are columns of w, set by a supervisor's ``Substitution``.
 """
 
 from __future__ import annotations
@@ -37,7 +39,8 @@ from uvsym.systems.system import System
 
 __all__ = ["WiredLoop", "interconnect", "RESERVED", "RAW"]
 
-RESERVED = ("x", "y", "u", "t", "held", "fault_sensor", "fault_actuator", "substitution")  # result groups
+# result groups, and the loop Functions' own argument names
+RESERVED = ("x", "y", "u", "t", "held", "fault_sensor", "fault_actuator", "substitution", "z", "w")
 RAW = ".raw"
 
 
@@ -120,7 +123,8 @@ def _resolve_units(readers: list[tuple[str, Signals]], who: dict, declared: dict
     return units
 
 
-def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str]) -> tuple[list[str], dict]:
+def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str],
+             substitutions: dict[str, str] | None = None) -> tuple[list[str], dict]:
     """(evaluation order, signal -> its expression free of placeholders).
 
     ``exprs[n]`` is signal n in terms of the placeholders ``P`` of the signals it reads; the
@@ -136,8 +140,11 @@ def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str]) 
         order = list(graphlib.TopologicalSorter(deps).static_order())
     except graphlib.CycleError as exc:
         cycle = " -> ".join(f"{n} ({who[n]})" for n in exc.args[1])
+        through = [c for c, s in (substitutions or {}).items() if s in exc.args[1]]
+        hint = (f"; it runs through the substitution of {', '.join(through)}: a block that must see the sensor "
+                f"reads '{through[0]}{RAW}'" if through else "")
         raise WiringError(f"algebraic loop: {cycle}; each signal needs the next within the same sample "
-                          "(break it with a block whose output does not depend on its input)") from None
+                          f"(break it with a block whose output does not depend on its input){hint}") from None
     values = {}
     for name in order:
         used = deps[name]
@@ -173,6 +180,10 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     _check(plant, blocks, dt, substeps)
     p = ca.DM(plant.p.vector(plant.p0 if p is None else p, f"{plant.name}: parameters p"))
     substitutions = dict(substitutions or {})
+    raw = [f"{c!r} -> {s!r}" for c, s in substitutions.items() if c.endswith(RAW) or s.endswith(RAW)]
+    if raw:
+        raise WiringError(f"substitutions {', '.join(raw)}: a substitution joins two published signals; "
+                          f"'{RAW}' is only for reading a sensor past its substitution")
     who, declared = _publishers(plant, blocks)
     plant_label = f"plant {plant.name}"
     readers = [(f"block {b.name}", b.reads) for b in blocks] + [(plant_label, plant.u)]
@@ -216,7 +227,7 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     y_true = plant.h(x, u_applied, p)
     y, held_next = apply_sensor_faults(y_true, t, sensor_faults, held, noise)
     exprs.update({name: y[i] for i, name in enumerate(plant.y.names)})
-    order, values = _resolve(exprs, P, who)
+    order, values = _resolve(exprs, P, who, substitutions)
     parts = {"x": (x, plant.x, plant.x.units), "y": (y, plant.y, plant.y.units),
              "u": (u_applied, plant.u, plant.u.units)}
     for b in blocks:

@@ -1,0 +1,74 @@
+"""Edges of wired loops found in review: sample timing at fault onsets, latches, initial states,
+sample periods of designed blocks, reserved names and the hints of wiring errors."""
+
+import math
+
+import numpy as np
+import pytest
+from problems import DT, double_integrator, first_order, integrator
+
+from uvsym.errors import FaultError, SimulationError, WiringError
+from uvsym.faults import ActuatorFault, Profile, SensorFault
+from uvsym.sim import block, interconnect, lqr, open_loop, pid, simulate_system, state_feedback
+
+
+def test_a_fault_starts_at_the_sample_that_rounds_just_below_its_onset():
+    dt, onset = 0.03, 0.45  # 15 * 0.03 = 0.44999999999999996 in doubles
+    assert 15 * dt < onset
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    result = simulate_system(integrator(), [hold], duration=0.6, dt=dt, x0=[0.0],
+                             actuator_faults=(ActuatorFault(0, "bias", 10.0, Profile("step", onset=onset)),),
+                             sensor_faults=(SensorFault(0, "bias", 1.0, Profile("step", onset=onset)),))
+    assert result["fault_actuator"].values[14, 0] == 0.0 and result["fault_actuator"].values[15, 0] == 10.0
+    assert result["fault_sensor"].values[14, 0] == 0.0 and result["fault_sensor"].values[15, 0] == 1.0
+
+
+def test_a_stuck_sensor_latches_the_last_sample_before_onset_whatever_its_profile():
+    drive = open_loop("drive", [0.0], [1.0], publishes=["u"])  # q = t
+    for profile in (Profile("step", onset=0.3), Profile("ramp", onset=0.3, duration=0.5)):
+        result = simulate_system(integrator(), [drive], duration=0.6, dt=0.1, x0=[0.0],
+                                 sensor_faults=(SensorFault(0, "stuck", profile=profile),))
+        measured = result["y"]["q"]
+        assert abs(measured[-1] - 0.2) < 1e-12 or profile.kind == "ramp", profile.kind  # held at q(0.2)
+        if profile.kind == "ramp":  # y = q + phi (held - q), held = q(0.2)
+            phi = min((0.6 - 0.3) / 0.5, 1.0)
+            assert abs(measured[-1] - (0.6 + phi * (0.2 - 0.6))) < 1e-9
+
+
+def test_a_pid_on_a_sensor_stuck_from_the_start_does_not_kick():
+    controller = pid("c", measured="m", kp=0.0, ki=0.0, kd=0.5, output="F", dt=DT)
+    result = simulate_system(first_order(), [controller], duration=0.1, dt=DT, x0=[0.3],
+                             sensor_faults=(SensorFault(0, "stuck"),))
+    assert np.allclose(result["c"]["F"], 0.0)  # y = 0.3 throughout: no derivative
+
+
+def test_blocks_designed_for_a_sample_period_refuse_another():
+    plant = double_integrator()
+    with pytest.raises(WiringError, match="0.01"):
+        interconnect(plant, [lqr(plant, np.eye(2), [[1.0]], dt=0.01)], dt=0.5)
+    with pytest.raises(WiringError, match="reserved"):
+        interconnect(plant, [state_feedback("z", [[1.0, 1.0]], reads=["pos", "vel"], publishes=["acc"])], dt=DT)
+
+
+def test_wiring_errors_and_bad_faults_are_typed_and_hint():
+    plant = integrator()
+    pre = block("pre", step=lambda s, r: (s, 2 * r), reads="q", publishes="a")
+    est = block("est", step=lambda s, r: (s, r), reads="a", publishes="q_hat")
+    ctrl = state_feedback("ctrl", [[1.0]], reads=["q"], publishes=["u"])
+    with pytest.raises(WiringError, match=r"substitution of q: a block that must see the sensor reads 'q.raw'"):
+        interconnect(plant, [pre, est, ctrl], dt=DT, substitutions={"q": "q_hat"})
+    with pytest.raises(WiringError, match="a substitution joins two published signals"):
+        interconnect(plant, [ctrl], dt=DT, substitutions={"q": "q.raw"})
+    with pytest.raises(FaultError, match="integer index"):
+        SensorFault("q", "bias", 1.0)
+    with pytest.raises(FaultError, match="onset must be a number"):
+        Profile("step", onset="1")
+
+    class Broken:
+        period = math.nan
+
+        def update(self, t, signals):
+            return None
+
+    with pytest.raises(SimulationError, match="positive, finite period"):
+        simulate_system(plant, [ctrl], duration=1.0, dt=DT, x0=[0.0], supervisor=Broken())
