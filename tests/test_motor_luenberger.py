@@ -22,7 +22,8 @@ def cases():
 
 def test_every_claim_has_its_expected_status():
     certificates = motor_claims()
-    assert [c.status for c in certificates] == [c.expected for c in certificates] == ["proved", "proved", "refuted"]
+    assert [c.status for c in certificates] == [c.expected for c in certificates] == \
+        ["proved", "proved", "proved", "refuted", "refuted"]
 
 
 def test_gain_places_the_error_eigenvalues_left_of_the_decay():
@@ -42,9 +43,9 @@ def test_observer_tracks_the_motor_and_detects_both_faults(cases):
     assert np.sqrt(np.mean(flux_error ** 2)) < 0.005 * healthy["x"]["lambda_rd"][0]  # unmeasured: RMS within 0.5 %
     t, above = cases["detection_time_s"], cases["time_above_threshold_s"]
     assert t["fault-free"] is None
-    assert FAULT_ONSET <= t["step (case b)"] <= FAULT_ONSET + 2e-4 and above["step (case b)"] > 0.02
+    assert FAULT_ONSET <= t["step (case b)"] <= FAULT_ONSET + 5e-4 and above["step (case b)"] > 0.02
     # the known limitation the report states: the plain observer follows a slow sensor drift
-    assert above["incipient (case a)"] <= 5e-4
+    assert t["incipient (case a)"] is None and above["incipient (case a)"] <= 5e-4
 
 
 @pytest.mark.parametrize("profile, size", [(Profile("step", onset=0.7), 0.5), (Profile("step", onset=1.3), -1.0),

@@ -95,3 +95,35 @@ def test_plant_json_summary_has_its_operating_point(capsys):
     assert main(["models", "show", "induction_motor", "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["operating_point"]["x"]["omega_m"] == 250.0 and summary["operating_point"]["u"]["u_sd"] > 0
+
+
+def test_observers_refuse_shared_names_and_bad_runs():
+    from uvsym.observers.base import observer
+
+    with pytest.raises(ObserverError, match=r"names \['a'\] stand in more than one"):
+        observer("o", step=lambda s, y, u, p: (s, s), state=signals(("a", "-")), reads_y=signals(("a", "-")),
+                 reads_u=signals(), publishes=signals(("b", "-")), dt=0.1)
+    obs = observer("o", step=lambda s, y, u, p: (0.5 * s + y, s), state=signals(("a", "-")),
+                   reads_y=signals(("b", "-")), reads_u=signals(), publishes=signals(("c", "-")), dt=0.1)
+    with pytest.raises(ObserverError, match="at least one sample"):
+        obs.run(np.zeros((0, 1)), np.zeros((0, 0)))
+    with pytest.raises(ObserverError, match="s0 must be 1 finite"):
+        obs.run(np.zeros((3, 1)), np.zeros((3, 0)), s0=[np.nan])
+    with pytest.raises(ObserverError, match="NaN constant"):
+        observer("o", step=lambda s, y, u, p: (s * math.nan, s), state=signals(("a", "-")),
+                 reads_y=signals(("b", "-")), reads_u=signals(), publishes=signals(("c", "-")), dt=0.1)
+
+
+def test_gain_synthesis_falls_back_to_the_rate_itself():
+    A, C = np.diag([-1.0, 2.0]), np.array([[0.0, 1.0]])  # the first mode is unobservable, at rate 1
+    design = synthesize_observer_gain(A, C, decay=0.995)  # 1 % more is infeasible, the rate itself is not
+    assert design.certificate.status == "proved"
+    with pytest.raises(UvsymError, match="at 1.515 1/s: infeasible and at 1.5 1/s: infeasible"):
+        synthesize_observer_gain(A, C, decay=1.5)
+
+
+def test_shared_plants_cannot_be_changed_by_one_user():
+    motor = uvsym.plant("induction_motor")
+    with pytest.raises(ValueError):
+        motor.x_op[0] = 99.0
+    assert uvsym.plant("otter", rp=np.array([0.05, 0.0, -0.3])).name == "otter"  # an array override is hashed

@@ -61,6 +61,9 @@ class Derivation:
     observer_sets: Mapping[str, Callable[..., ObserverSet]] = field(default_factory=dict)
 
     def __post_init__(self):
+        if not isinstance(self.observer_sets, Mapping):
+            raise DerivationError(f"derivation {self.name!r}: observer_sets must map set names to factories, "
+                                  f"got {type(self.observer_sets).__name__}")
         parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
                  **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}
         bad = [part for part, f in parts.items() if not callable(f)]
@@ -78,8 +81,8 @@ def _load(ep: EntryPoint) -> Derivation:
     where = f"entry point {ep.name!r} = {ep.value!r} (group {GROUP})"
     try:
         loaded = ep.load()
-    except (ImportError, AttributeError) as exc:
-        raise DerivationError(f"{where} cannot be loaded: {exc}") from exc
+    except Exception as exc:  # a plug-in's own bug (SyntaxError, ValueError, ...) is reported, named
+        raise DerivationError(f"{where} cannot be loaded: {type(exc).__name__}: {exc}") from exc
     if not isinstance(loaded, Derivation):
         raise DerivationError(f"{where} is a {type(loaded).__name__}, not a uvsym.derivation.Derivation")
     if loaded.name != ep.name:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4"]
+__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4", "as_column", "has_nan_constant"]
 
 _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
@@ -69,3 +69,18 @@ def rk4(ode, s, h: float, steps: int, *args, t=0.0):
         k4 = ode(s + dh * k3, *args, ti + dh)
         s = s + dh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return s
+
+
+def as_column(value) -> ca.SX:
+    """An SX column from what a user's equation returned (SX, numbers, or a list of them);
+    TypeError naming the type otherwise."""
+    try:
+        return ca.vec(ca.vertcat(*value) if isinstance(value, (list, tuple)) else ca.SX(value))
+    except (NotImplementedError, TypeError, RuntimeError):
+        raise TypeError(f"expected a CasADi expression or a list of them, got {type(value).__name__}") from None
+
+
+def has_nan_constant(function: ca.Function) -> bool:
+    """True when an SX Function's graph holds a NaN constant (e.g. math.sin applied to a symbol)."""
+    return any(function.instruction_id(k) == ca.OP_CONST and np.isnan(function.instruction_constant(k))
+               for k in range(function.n_instructions()))

@@ -5,6 +5,8 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 
+import numpy as np
+
 from uvsym.errors import UnknownNameError
 from uvsym.models.model import Model
 from uvsym.models.vehicles import docking_auv, otter, otter3dof, remus100, torpedo
@@ -40,6 +42,7 @@ def vehicle(name: str, **overrides) -> Model:
     """
     if name not in VEHICLES:
         raise UnknownNameError(f"unknown vehicle {name!r}; known vehicles: {', '.join(VEHICLES)}")
-    frozen = tuple(sorted((key, tuple(value) if isinstance(value, (list, tuple)) else value)
+    frozen = tuple(sorted((key, tuple(np.asarray(value, dtype=float).ravel().tolist())
+                           if isinstance(value, (list, tuple, np.ndarray)) else value)
                           for key, value in overrides.items()))
     return _build_cached(name, frozen)

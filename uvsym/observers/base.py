@@ -34,6 +34,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import ObserverError
+from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
 
 __all__ = ["Observer", "check_name", "observer", "STEP_INPUTS", "STEP_OUTPUTS"]
@@ -67,6 +68,13 @@ class Observer:
     description: str = ""
 
     def __post_init__(self):
+        check_name(self.name, "observer")
+        groups = (self.state, self.reads_y, self.reads_u, self.params)
+        names = [n for g in groups for n in g.names]
+        shared = sorted({n for n in names if names.count(n) > 1})
+        if shared:
+            raise ObserverError(f"{self.name}: names {shared} stand in more than one of state, reads_y, reads_u, "
+                                "params; each signal needs its own name")
         f = self.step
         if not isinstance(f, ca.Function):
             raise ObserverError(f"{self.name}: step must be a casadi.Function, got {type(f).__name__}")
@@ -120,8 +128,12 @@ class Observer:
         if Y.shape[1] != self.reads_y.size or U.shape[1] != self.reads_u.size or len(Y) != len(U):
             raise ObserverError(f"{self.name}: Y must be (N, {self.reads_y.size}) and U (N, {self.reads_u.size}), "
                                 f"got {Y.shape} and {U.shape}")
+        if len(Y) == 0 or not (np.all(np.isfinite(Y)) and np.all(np.isfinite(U))):
+            raise ObserverError(f"{self.name}: Y and U need at least one sample and finite values")
         p = self.parameters(p)
-        s = self.initial_state(Y[0], U[0], p) if s0 is None else np.asarray(s0, dtype=float)
+        s = self.initial_state(Y[0], U[0], p) if s0 is None else np.asarray(s0, dtype=float).reshape(-1)
+        if s.size != self.state.size or not np.all(np.isfinite(s)):
+            raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
         roll = self.step.mapaccum("run", len(Y), [0], [0])
         S, OUT = roll(s, Y.T, U.T, p)
         return np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
@@ -147,7 +159,10 @@ def observer(name: str, *, step: Callable, state: Signals, reads_y: Signals, rea
     result = step(s, y, u, p)
     if not isinstance(result, tuple) or len(result) != 2:
         raise ObserverError(f"{name}: step must return (s_next, out)")
-    s_next, out = (ca.densify(ca.vec(ca.SX(v))) for v in result)
+    try:
+        s_next, out = (ca.densify(as_column(v)) for v in result)
+    except TypeError as exc:
+        raise ObserverError(f"{name}: step: {exc}") from None
     for what, expr, group in (("s_next", s_next, state), ("out", out, publishes)):
         if expr.numel() != group.size:
             raise ObserverError(f"{name}: step gives {what} with {expr.numel()} entries, expected {group.size}")
@@ -156,5 +171,8 @@ def observer(name: str, *, step: Callable, state: Signals, reads_y: Signals, rea
     if stray:
         raise ObserverError(f"{name}: step uses symbols other than s, y, u, p: {stray}")
     function = ca.Function(f"{name}_step", [s, y, u, p], [s_next, out], list(STEP_INPUTS), list(STEP_OUTPUTS))
+    if has_nan_constant(function):
+        raise ObserverError(f"{name}: the step holds a NaN constant: a math or numpy function applied to a CasADi "
+                            "symbol gives NaN; use casadi's own (ca.sin, ca.exp, ...)")
     return Observer(name=name, step=function, state=state, reads_y=reads_y, reads_u=reads_u, params=params,
                     publishes=publishes, p0=np.zeros(params.size) if p0 is None else p0, dt=dt, **options)

@@ -27,7 +27,7 @@ from uvsym.conventions import FORCE_LABELS
 from uvsym.faults import actuator_kind
 from uvsym.models.model import Model
 from uvsym.observers.actuator import actuator_observer
-from uvsym.observers.base import Observer
+from uvsym.observers.base import Observer, check_name
 from uvsym.systems.signals import Signals
 
 __all__ = ["SampledObserver", "actuator_fault_observer", "gain_units", "sampled_observer"]
@@ -115,11 +115,19 @@ def sampled_observer(function: ca.Function, dt: float) -> SampledObserver:
 
 
 def gain_units(kind: str, form: str, force_units: tuple[str, ...]) -> tuple[str, ...]:
-    """Units of the gain entries K of an actuator observer (rate k tau_d^2 or k, per channel)."""
-    if kind == "proportional":
-        unit = "1/(s (N or N m)^2)" if form == "momentum" else "kg^2/(s (N or N m)^2)"
-        return (unit,) * len(force_units)
-    return ("1/s" if form == "momentum" else "kg^2/s",) * len(force_units)
+    """Units of the gain entries K per channel: the rate is ``k_i`` (times ``tau_d,i^2`` when the
+    fault scales the command) in the momentum form, and that over ``m_i^2`` in the paper's form,
+    with ``m_i`` in kg for a force channel (N) and kg m^2 for a moment channel (N m)."""
+    scales = actuator_kind(kind).scales
+    units = []
+    for force in force_units:
+        per_force = f" {force}^2" if " " not in force else f" ({force})^2"
+        mass = "kg^2" if force == "N" else "kg^2 m^4"
+        if form == "momentum":
+            units.append(f"1/(s{per_force})" if scales else "1/s")
+        else:
+            units.append(f"{mass}/(s{per_force})" if scales else f"{mass}/s")
+    return tuple(units)
 
 
 def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "paper",
@@ -131,6 +139,7 @@ def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "
     N and N m); publishes ``f_hat.<force>`` (the fault estimate: factors for proportional, forces
     otherwise). The continuous observer is kept in ``equations["continuous"]``.
     """
+    check_name(name or kind, "observer")
     continuous = actuator_observer(model, kind, form)
     sampled = sampled_observer(continuous.function, dt)
     n = model.dof

@@ -26,20 +26,28 @@ GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "
 
 
 def signal_latex(name: str) -> str:
-    """LaTeX of a signal name: ``base_sub`` -> base with subscript, a ``_hat`` suffix or ``hat`` part
-    -> a hat, ``r_<y>`` -> ``r_{<y>}``, Greek bases as Greek letters, ``a.b`` -> ``a_{b}``."""
-    hat = False
-    parts = re.split(r"[._]", name)
-    if "hat" in parts:
-        hat, parts = True, [p for p in parts if p != "hat"]
-    base, subscript = parts[0], ",".join(p for p in parts[1:] if p)
-    tex = f"\\{base}" if base in GREEK else (base if len(base) == 1 else r"\mathrm{" + base + "}")
+    """LaTeX of a signal name: ``base_sub`` -> base with subscript (parts joined by commas), a
+    ``hat`` part -> a hat on the base, Greek bases and parts as Greek letters, ``a.b`` -> ``a_{b}``;
+    characters LaTeX treats specially are escaped."""
+    parts = [p for p in re.split(r"[._]", name) if p]
+    hat = "hat" in parts[1:]
+    parts = [p for i, p in enumerate(parts) if p != "hat" or i == 0] or [name]
+    base, rest = parts[0], parts[1:]
+    tex = _word(base, upright=len(base) > 1)
     if hat:
         tex = f"\\hat{{{tex}}}"
-    if subscript:
-        subscript = ",".join(f"\\{p}" if p in GREEK else p for p in subscript.split(","))
-        tex = f"{tex}_{{{subscript}}}"
+    if rest:
+        tex = f"{tex}_{{{','.join(_word(p, upright=False) for p in rest)}}}"
     return tex
+
+
+def _word(word: str, upright: bool) -> str:
+    """A Greek letter, or the word with LaTeX's special characters escaped (upright if asked)."""
+    if word in GREEK:
+        return f"\\{word}"
+    escaped = re.sub(r"([#$%&{}~^\\])", lambda m: "\\" + m.group(1) if m.group(1) not in "~^\\"
+                     else {"~": r"\textasciitilde{}", "^": r"\^{}", "\\": r"\backslash{}"}[m.group(1)], word)
+    return r"\mathrm{" + escaped + "}" if upright else escaped
 
 
 def function_equations(function: ca.Function, inputs: list[Signals], outputs: list[tuple[Signals, str]],

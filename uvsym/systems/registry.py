@@ -10,6 +10,8 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 
+import numpy as np
+
 from uvsym.errors import UnknownNameError
 from uvsym.systems.plants import induction_motor, quadrotor, rov_yaw
 from uvsym.systems.system import System
@@ -55,6 +57,7 @@ def plant(name: str, **overrides) -> System:
     """
     if name not in PLANTS and name not in _vehicle_names():
         raise UnknownNameError(f"unknown plant {name!r}; known plants: {', '.join(plant_names())}")
-    frozen = tuple(sorted((key, tuple(value) if isinstance(value, (list, tuple)) else value)
+    frozen = tuple(sorted((key, tuple(np.asarray(value, dtype=float).ravel().tolist())
+                           if isinstance(value, (list, tuple, np.ndarray)) else value)
                           for key, value in overrides.items()))
     return _build_cached(name, frozen)

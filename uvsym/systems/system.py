@@ -20,6 +20,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import ModelError
+from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
 
 __all__ = ["System", "Linearization", "system"]
@@ -30,7 +31,8 @@ ARGUMENTS = ("x", "u", "d", "p")
 @dataclass(frozen=True)
 class Linearization:
     """``dx = A dx + B du + E dd`` (continuous; ``x_next`` in discrete time), ``dy = C dx + D du``
-    about ``(x0, u0, d0, p0)``; ``f0`` = f there (0 at an equilibrium), ``y0`` = h there."""
+    about ``(x0, u0, d0, p0)``; ``f0`` = f there (at an equilibrium 0 in continuous time, x0 in
+    discrete time), ``y0`` = h there."""
 
     A: np.ndarray
     B: np.ndarray
@@ -96,6 +98,10 @@ class System:
             else:
                 value = group.vector(value, f"{self.name}: {attr}")
             object.__setattr__(self, attr, value)
+        for attr in ("p0", "x_op", "u_op", "u_min", "u_max"):  # frozen data: shared by every cached user
+            frozen = np.array(getattr(self, attr), dtype=float)
+            frozen.setflags(write=False)
+            object.__setattr__(self, attr, frozen)
         low = [n for n, lo, hi in zip(self.u.names, self.u_min, self.u_max) if not lo < hi]
         if low:
             raise ModelError(f"{self.name}: inputs {low} have lower bound >= upper bound")
@@ -172,12 +178,11 @@ def _check_function(name: str, function, inputs: tuple, sizes: dict, outputs: di
 
 
 def _expression(name: str, what: str, value) -> ca.SX:
-    """An SX column from what a user's rhs/output returned (SX, a list of SX and numbers, ...)."""
+    """An SX column from what a user's rhs/output returned; ModelError otherwise."""
     try:
-        return ca.vec(ca.vertcat(*value) if isinstance(value, (list, tuple)) else ca.SX(value))
-    except (NotImplementedError, TypeError, RuntimeError):
-        raise ModelError(f"{name}: {what} must return a CasADi expression or a list of them, "
-                         f"got {type(value).__name__}") from None
+        return as_column(value)
+    except TypeError as exc:
+        raise ModelError(f"{name}: {what} must return a CasADi expression or a list of them ({exc})") from None
 
 
 def system(name: str, description: str, *, x: Signals, u: Signals, rhs: Callable,
@@ -213,9 +218,7 @@ def system(name: str, description: str, *, x: Signals, u: Signals, rhs: Callable
     if stray:
         raise ModelError(f"{name}: the equations use symbols other than x, u, d, p: {stray}")
     for what, expr in (("rhs", rhs_expr), ("output", out_expr)):
-        graph = ca.Function("graph", syms, [expr], {"allow_free": True})
-        if any(graph.instruction_id(k) == ca.OP_CONST and np.isnan(graph.instruction_constant(k))
-               for k in range(graph.n_instructions())):
+        if has_nan_constant(ca.Function("graph", syms, [expr], {"allow_free": True})):
             raise ModelError(f"{name}: the {what} holds a NaN constant: a math or numpy function applied to a "
                              "CasADi symbol gives NaN; use casadi's own (ca.sin, ca.exp, ...)")
     out_name = "x_dot" if dt is None else "x_next"

@@ -31,8 +31,10 @@ Numbers: the paper's are in a reference it does not reproduce; these are the Mod
 Library IM_SquirrelCageData defaults at full precision (Lm = 3 sqrt(1 - 0.0667) / (2 pi 50 Hz),
 Ls = Lr = 3 / (2 pi 50 Hz); rounded to 9.225 and 9.549 mH they would give beta = 1516.6, not
 1516.7). omega_s = 500 rad/s puts omega_m at 250 rad/s, where the paper's 1 rad/s fault is 0.4 %;
-I0 = 30 A is uvsym's choice: the stator voltage omega_s Ls I0 = 143 V is then the data's nominal
-peak phase voltage (sqrt(2) 100 V), field-weakened at this 80 Hz supply.
+I0 = 30 A is uvsym's choice: the stator voltage omega_s Ls I0 = 143 V is then close to the data's
+nominal peak phase voltage (sqrt(2) 100 V), field-weakened at this 80 Hz supply. mu is as
+printed, without the 3/2 of an amplitude-invariant d-q transform, so the torque, and with it the
+speed's response to the currents, follows the paper rather than the Modelica machine.
 """
 
 from __future__ import annotations
