@@ -72,3 +72,18 @@ def test_wiring_errors_and_bad_faults_are_typed_and_hint():
 
     with pytest.raises(SimulationError, match="positive, finite period"):
         simulate_system(plant, [ctrl], duration=1.0, dt=DT, x0=[0.0], supervisor=Broken())
+
+
+def test_a_discrete_plant_steps_its_own_map_in_the_loop():
+    """The ZOH double integrator under u = -K x follows (Ad - Bd K)^k x0 exactly."""
+    plant = double_integrator().discretize(0.1, "zoh")
+    K = np.array([[2.0, 1.5]])
+    feedback = state_feedback("sf", K, reads=["pos", "vel"], publishes=["acc"])
+    result = simulate_system(plant, [feedback], duration=2.0, dt=0.1, x0=[1.0, 0.0])
+    Ad, Bd = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    expected = [np.linalg.matrix_power(Ad - Bd @ K, k) @ [1.0, 0.0] for k in range(21)]
+    np.testing.assert_allclose(np.column_stack([result["x"]["pos"], result["x"]["vel"]]), expected, atol=1e-12)
+    with pytest.raises(SimulationError, match="nothing to integrate"):
+        simulate_system(plant, [feedback], duration=1.0, dt=0.1, x0=[1.0, 0.0], method="cvodes")
+    with pytest.raises(WiringError, match="sampled every 0.1 s, the loop every 0.05 s"):
+        interconnect(plant, [feedback], dt=0.05)

@@ -20,7 +20,8 @@ class SampledLoop:
 
     discrete(z, w) -> (z_disc, u_cmd, out): the discrete part's next state, the plant inputs held
     over the sample, the logged signals (``signals``: name -> (slice of out, labels, units));
-    plant_ode(s, u_cmd, env, t) -> s_dot; step(z, w) -> (z_next, out) the fixed-step path
+    plant_ode(s, u_cmd, env, t) -> s_dot (None for a discrete-time plant: fast path only);
+    step(z, w) -> (z_next, out) the fixed-step path
     (``substeps`` RK4 steps of the plant per sample); layout: part of z -> slice. env_columns:
     where w holds the plant's environment; correction_columns: (vec(S), o) of a command
     correction, or None; substitution_columns: measurement channel -> its switch column.
@@ -32,7 +33,7 @@ class SampledLoop:
     n_w: int
     n_s: int
     discrete: ca.Function
-    plant_ode: ca.Function
+    plant_ode: ca.Function | None
     step: ca.Function
     layout: dict
     signals: dict

@@ -125,6 +125,8 @@ def _decision_columns(loop: SampledLoop, decision) -> tuple[slice | list[int], n
 def _stepper(loop: SampledLoop, method: str, chunk: int, options: dict, compiled: bool):
     """(advance(z, W_rows, out_rows) -> z_end, seconds spent building); advance fills out_rows (k, n_out)."""
     started = time.perf_counter()
+    if method != "fast" and loop.plant_ode is None:
+        raise SimulationError(f"a discrete-time plant has nothing to integrate: use method 'fast', not {method!r}")
     if method == "fast":
         if compiled and find_compiler() is not None:
             try:

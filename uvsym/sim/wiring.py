@@ -15,7 +15,9 @@ the plant's disturbances, and one switch (0 or 1) per substitution channel. At e
 in the order the outputs depend on each other; the plant inputs u_k are held over the sample
 while ``x' = f(x, u_f(u_k, t), d_k, p)`` is integrated, with actuator faults u_f in continuous
 time (the fixed-step RK4 path smears a fault that switches inside a sample over that sample;
-the CasADi integrators, or onsets on the sample grid, avoid it). Measurement substitution
+the CasADi integrators, or onsets on the sample grid, avoid it). A discrete-time plant (its
+``dt`` equal to the loop's) steps ``x_{k+1} = f_d(x_k, u_f(u_k, t_k), d_k, p)`` instead, on the
+fast path only. Measurement substitution
 ``{"psi": "psi_hat"}``: while channel psi is on, every block that reads ``psi`` gets ``psi_hat``
 instead, except the block publishing ``psi_hat`` (an estimator keeps seeing its sensor); switches
 are columns of w, set by a supervisor's ``Substitution``.
@@ -67,12 +69,12 @@ def _column(items) -> ca.SX:
 
 
 def _check(plant: System, blocks: tuple[Block, ...], dt: float, substeps: int) -> None:
-    """WiringError for a discrete plant, a bad period, repeated or reserved block names, a block
-    designed for another period."""
-    if plant.discrete:
-        raise WiringError(f"plant {plant.name} is discrete (dt = {plant.dt} s); wire its continuous form")
+    """WiringError for a bad period, a discrete plant sampled at another period, repeated or
+    reserved block names, a block designed for another period."""
     if not (np.isfinite(dt) and dt > 0) or not (isinstance(substeps, int) and substeps >= 1):
         raise WiringError(f"dt must be positive (s) and substeps a positive integer, got {dt} and {substeps!r}")
+    if plant.discrete and abs(plant.dt - dt) > 1e-9 * dt:
+        raise WiringError(f"plant {plant.name} is sampled every {plant.dt:g} s, the loop every {dt:g} s")
     for b in blocks:
         if not isinstance(b, Block):
             raise WiringError(f"blocks must be Block objects, got {type(b).__name__}")
@@ -245,10 +247,14 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     discrete = ca.Function("wired_loop_discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
     reads = ca.Function("wired_loop_reads", [z, w], reads, ["z", "w"], [b.name for b in blocks])
 
-    s, uc, env, ts = ca.SX.sym("s", n_x), ca.SX.sym("u_cmd", plant.u.size), ca.SX.sym("env", n_d), ca.SX.sym("t")
-    s_dot = plant.f(s, apply_actuator_faults(uc, ts, actuator_faults), env, p)
-    plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
-    x_next = rk4(plant_ode, x, dt, substeps, u_cmd, d, t=t)
+    if plant.discrete:  # x_{k+1} = f_d(x_k, u_k, d_k, p): no integration, and no integrator path
+        plant_ode = None
+        x_next = plant.f(x, apply_actuator_faults(u_cmd, t, actuator_faults), d, p)
+    else:
+        s, uc, env, ts = ca.SX.sym("s", n_x), ca.SX.sym("u_cmd", plant.u.size), ca.SX.sym("env", n_d), ca.SX.sym("t")
+        s_dot = plant.f(s, apply_actuator_faults(uc, ts, actuator_faults), env, p)
+        plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
+        x_next = rk4(plant_ode, x, dt, substeps, u_cmd, d, t=t)
     step = ca.Function("wired_loop_step", [z, w], [ca.densify(ca.vertcat(x_next, z_disc)), out], ["z", "w"],
                        ["z_next", "out"], {"cse": True})
     return WiredLoop(plant=plant, blocks=blocks, p=np.asarray(p).ravel(), dt=float(dt), substeps=substeps, n_z=n_z,
