@@ -24,32 +24,14 @@ def _find_chromium():
     return next((path for name in ("chromium", "chromium-browser") if (path := shutil.which(name))), None)
 
 
-def _install_chromium() -> str:
-    """Install Debian's chromium where this runs as root with apt-get; the reason when it cannot."""
-    import os
-    import shutil
-    import subprocess
-
-    if shutil.which("apt-get") is None or os.geteuid() != 0:
-        return "no chromium on PATH, and no apt-get as root to install Debian's package"
-    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    for commands in ([["apt-get", "install", "-y", "-q", "chromium"]],
-                     [["apt-get", "update", "-q"], ["apt-get", "install", "-y", "-q", "chromium"]]):
-        if all(subprocess.run(c, env=env, capture_output=True, timeout=900).returncode == 0 for c in commands):
-            return ""
-    return "apt-get could not install chromium"
-
-
 @pytest.fixture(scope="session")
 def browser():
-    """A headless Debian chromium driven by Playwright (installed here where possible, else skipped)."""
+    """A headless Debian chromium driven by Playwright; skipped, with the reason, where there is none
+    (``scripts/install-test-browser.sh`` installs it, as ``.ci/run`` does)."""
     playwright = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (.[test] has it)")
     path = _find_chromium()
     if path is None:
-        reason = _install_chromium()
-        path = _find_chromium()
-        if path is None:
-            pytest.skip(reason or "chromium was installed but is not on PATH")
+        pytest.skip("no chromium on PATH (scripts/install-test-browser.sh installs Debian's package as root)")
     with playwright.sync_playwright() as p:
         instance = p.chromium.launch(executable_path=path, args=CHROMIUM_ARGS)
         yield instance
