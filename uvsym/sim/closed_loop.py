@@ -26,7 +26,7 @@ from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
 from uvsym.observers.base import Observer
 from uvsym.sim.controllers import Autopilot
-from uvsym.sim.loop import SampledLoop
+from uvsym.sim.loop import SampledLoop, logged_signals
 from uvsym.symbolic import rk4
 
 __all__ = ["ClosedLoop", "build_closed_loop"]
@@ -72,7 +72,7 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     n, m = 2 * model.dof, model.n_inputs
     n_c = len(controller.state_labels)
     for obs in observers:
-        if abs(obs.dt - dt) > 1e-12 * dt:
+        if abs(obs.dt - dt) > 1e-9 * dt:
             raise SimulationError(f"observer {obs.name} is sampled every {obs.dt:g} s, the loop every {dt:g} s")
     n_o = sum(obs.state.size for obs in observers)
     layout, start = {}, 0
@@ -125,11 +125,7 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
             raise SimulationError(f"observer {obs.name}: its published names {list(obs.publishes.names)} do not stay "
                                   "apart once their '<quantity>.' prefix is dropped (this loop logs labels only)")
         out_parts[f"f_hat/{obs.name}"] = (f_hat, labels, obs.publishes.units)
-    out = ca.vertcat(*[part[0] for part in out_parts.values()])
-    signals, offset = {}, 0
-    for name, (expr, labels, units) in out_parts.items():
-        signals[name] = (slice(offset, offset + expr.numel()), tuple(labels), tuple(units))
-        offset += expr.numel()
+    out, signals = logged_signals(out_parts)
 
     z_disc = ca.vertcat(xc_next, *xo_next, a_expected_next, held_next)
     # dense outputs: buffers and mapaccum read them as plain arrays

@@ -1,7 +1,8 @@
 """What the runner (:func:`uvsym.sim.run.run_closed_loop`) needs of a sampled closed loop.
 
 Both loop builders, the marine scenario loop (:mod:`uvsym.sim.closed_loop`) and loops wired by
-signal name (:mod:`uvsym.sim.wiring`), return a subclass of :class:`SampledLoop`.
+signal name (:mod:`uvsym.sim.wiring`), return a subclass of :class:`SampledLoop`, and share the
+helpers below: the logged-signal layout, the per-sample input table W and the faults' meta.
 """
 
 from __future__ import annotations
@@ -9,8 +10,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import casadi as ca
+import numpy as np
 
-__all__ = ["SampledLoop"]
+from uvsym.errors import SimulationError
+
+__all__ = ["SampledLoop", "fault_summary", "logged_signals", "per_sample", "sample_inputs"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -40,3 +44,37 @@ class SampledLoop:
     env_columns: slice
     correction_columns: slice | None = None
     substitution_columns: dict = field(default_factory=dict)
+
+
+def logged_signals(parts: dict[str, tuple]) -> tuple[ca.SX, dict]:
+    """(out, name -> (slice of out, labels, units)) from name -> (expression, labels, units), in order."""
+    signals, offset = {}, 0
+    for name, (expr, labels, units) in parts.items():
+        signals[name] = (slice(offset, offset + expr.numel()), tuple(labels), tuple(units))
+        offset += expr.numel()
+    return ca.vertcat(*[expr for expr, _, _ in parts.values()]), signals
+
+
+def per_sample(values, size: int, N: int, what: str) -> np.ndarray:
+    """(N + 1, size) rows from a constant (size,) or one row per sample; SimulationError otherwise."""
+    table = np.asarray(values, dtype=float)
+    if table.shape not in ((size,), (N + 1, size)) or not np.all(np.isfinite(table)):
+        raise SimulationError(f"{what} must be {size} finite values, or one such row per sample ({N + 1}), "
+                              f"got shape {table.shape}")
+    return np.broadcast_to(table, (N + 1, size))
+
+
+def sample_inputs(n_w: int, N: int, dt: float, n_noise: int, seed: int) -> np.ndarray:
+    """W (N + 1, n_w): column 0 the sample times k dt (s), columns 1..n_noise standard normal draws
+    (seeded) behind sensor noise faults, the rest 0 for the caller to fill."""
+    W = np.zeros((N + 1, n_w))
+    W[:, 0] = dt * np.arange(N + 1)
+    W[:, 1:1 + n_noise] = np.random.default_rng(seed).standard_normal((N + 1, n_noise))
+    return W
+
+
+def fault_summary(fault, target: str) -> dict:
+    """JSON-friendly fault for a result's meta: target, kind, value, profile, onset and end (s; None: never)."""
+    profile = fault.profile
+    return {"target": target, "kind": fault.kind, "value": fault.value, "profile": profile.kind,
+            "onset_s": profile.onset, "end_s": None if profile.end == float("inf") else profile.end}

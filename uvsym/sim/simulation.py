@@ -14,6 +14,7 @@ from uvsym.observers.discrete import actuator_fault_observer
 from uvsym.observers.gains import design_gains
 from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.controllers import Autopilot
+from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, grid, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
@@ -50,18 +51,13 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     """
     N = grid(duration, dt)
     env = np.asarray(current, dtype=float)
-    if env.shape not in ((2,), (N + 1, 2)) or not np.all(np.isfinite(env)):
-        raise SimulationError(f"current must be finite (V_c, beta_c), or one such row per sample ({N + 1}), "
-                              f"got shape {env.shape}")
+    per_sample(env, 2, N, "current (V_c m/s, beta_c rad)")
     loop = build_closed_loop(model, controller, dt, actuator_faults=tuple(actuator_faults),
                              sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
                              current=tuple(env) if env.shape == (2,) else None)
     dof, m, n = model.dof, model.n_inputs, 2 * model.dof
     x0 = np.concatenate([_vector(eta0, dof, "eta0"), _vector(nu0, dof, "nu0")])
-    rng = np.random.default_rng(seed)
-    W = np.empty((N + 1, loop.n_w))  # one row per sample: [t, noise, V_c, beta_c, vec(S), o]
-    W[:, 0] = dt * np.arange(N + 1)
-    W[:, 1:1 + n] = rng.standard_normal((N + 1, n))
+    W = sample_inputs(loop.n_w, N, dt, n, seed)  # one row per sample: [t, noise, V_c, beta_c, vec(S), o]
     W[:, 1 + n:3 + n] = env.reshape(-1, 2)
     W[:, 3 + n:] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
 
@@ -83,8 +79,8 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
                                      compiled=compiled, progress=progress)
     meta = {"vehicle": model.name, "method": method, "dt_s": dt, "duration_s": duration, "substeps": substeps,
             "seed": seed, "observers": [obs.name for obs in observers],
-            "actuator_faults": [_describe(f, model.input_labels[f.actuator]) for f in actuator_faults],
-            "sensor_faults": [_describe(f, model.state_labels[f.channel]) for f in sensor_faults], **timing}
+            "actuator_faults": [fault_summary(f, model.input_labels[f.actuator]) for f in actuator_faults],
+            "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults], **timing}
     return SimResult(result.t, result.signals, meta)
 
 
@@ -95,12 +91,6 @@ def _vector(values, size: int, name: str) -> np.ndarray:
     if not np.all(np.isfinite(array)):
         raise SimulationError(f"{name} has non-finite entries: {array.tolist()}")
     return array
-
-
-def _describe(fault, target: str) -> dict:
-    profile = fault.profile
-    return {"target": target, "kind": fault.kind, "value": fault.value, "profile": profile.kind,
-            "onset_s": profile.onset, "end_s": None if profile.end == float("inf") else profile.end}
 
 
 def scenario_observers(model: Model, specs: tuple[ObserverSpec, ...]) -> dict[str, tuple[ActuatorObserver, np.ndarray]]:

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import numpy as np
 
-from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
+from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, grid, run_closed_loop
 from uvsym.sim.wiring import WiredLoop, interconnect
@@ -31,14 +29,6 @@ def initial_state(loop: WiredLoop, x0, w0: np.ndarray) -> np.ndarray:
         for b, r0 in zip(loop.blocks, loop.reads.call([z0, w0])):  # call: a list even for one block
             z0[loop.layout[b.name]] = b.initial_state(np.asarray(r0).ravel())
     return z0
-
-
-def _disturbances(d, size: int, N: int) -> np.ndarray:
-    table = np.zeros(size) if d is None else np.asarray(d, dtype=float)
-    if table.shape not in ((size,), (N + 1, size)) or not np.all(np.isfinite(table)):
-        raise SimulationError(f"d must be {size} finite disturbances, or one such row per sample ({N + 1}), "
-                              f"got shape {table.shape}")
-    return np.broadcast_to(table, (N + 1, size))
 
 
 def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, method: str = "fast",
@@ -69,24 +59,15 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     N = grid(duration, dt)
     loop = interconnect(plant, blocks, dt=dt, actuator_faults=tuple(actuator_faults),
                         sensor_faults=tuple(sensor_faults), substitutions=substitutions, substeps=substeps, p=p)
-    rng = np.random.default_rng(seed)
-    n_y = plant.y.size
-    W = np.zeros((N + 1, loop.n_w))  # one row per sample: [t, noise, d, substitution switches]
-    W[:, 0] = dt * np.arange(N + 1)
-    W[:, 1:1 + n_y] = rng.standard_normal((N + 1, n_y))
-    W[:, loop.env_columns] = _disturbances(d, plant.d.size, N)
+    W = sample_inputs(loop.n_w, N, dt, plant.y.size, seed)  # one row per sample: [t, noise, d, switches]
+    W[:, loop.env_columns] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
     z0 = initial_state(loop, x0, W[0])
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
                                      compiled=compiled, progress=progress)
     meta = {"plant": plant.name, "method": method, "dt_s": dt, "duration_s": duration, "substeps": substeps,
             "seed": seed, "blocks": [b.name for b in loop.blocks], "order": list(loop.order),
             "substitutions": dict(substitutions or {}),
-            "actuator_faults": [{"input": plant.u.names[f.actuator], **_fault(f)} for f in actuator_faults],
-            "sensor_faults": [{"output": plant.y.names[f.channel], **_fault(f)} for f in sensor_faults], **timing}
+            "actuator_faults": [fault_summary(f, plant.u.names[f.actuator]) for f in actuator_faults],
+            "sensor_faults": [fault_summary(f, plant.y.names[f.channel]) for f in sensor_faults], **timing}
     return SimResult(result.t, result.signals, meta)
 
-
-def _fault(fault) -> dict:
-    """JSON-friendly fault: kind, value and profile (an unbounded end as None)."""
-    profile = {k: (None if v == float("inf") else v) for k, v in asdict(fault.profile).items()}
-    return {"kind": fault.kind, "value": fault.value, "profile": profile}

@@ -34,7 +34,7 @@ import numpy as np
 from uvsym.errors import WiringError
 from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
 from uvsym.sim.blocks import Block
-from uvsym.sim.loop import SampledLoop
+from uvsym.sim.loop import SampledLoop, logged_signals
 from uvsym.symbolic import rk4
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
@@ -154,15 +154,6 @@ def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str],
     return order, values
 
 
-def _logged(parts: dict[str, tuple]) -> tuple[ca.SX, dict]:
-    """(out, group -> (slice of out, labels, units)) from group -> (expression, labels, units)."""
-    signals, offset = {}, 0
-    for group, (expr, labels, units) in parts.items():
-        signals[group] = (slice(offset, offset + expr.numel()), tuple(labels), tuple(units))
-        offset += expr.numel()
-    return ca.vertcat(*[expr for expr, _, _ in parts.values()]), signals
-
-
 def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[ActuatorFault, ...] = (),
                  sensor_faults: tuple[SensorFault, ...] = (), substitutions: dict[str, str] | None = None,
                  substeps: int = 1, p=None) -> WiredLoop:
@@ -239,7 +230,7 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     parts["fault_actuator"] = (u_applied - u_cmd, plant.u, plant.u.units)
     if substitutions:
         parts["substitution"] = (on, tuple(substitutions), ("-",) * n_c)
-    out, signals = _logged(parts)
+    out, signals = logged_signals(parts)
     names = tuple(P)
     resolved = ca.substitute([u_cmd, _column(s_next + [held_next]), out] + reads, [P[n] for n in names],
                              [values[n] for n in names])
