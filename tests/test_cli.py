@@ -228,3 +228,40 @@ def test_unknown_observer_sets_and_options_are_refused_by_name():
         observer_set("sliding-mode")
     with pytest.raises(UnknownNameError, match="takes no option --colour; its options: --vehicle, --form"):
         observer_set("actuator-observers", colour="red")
+
+
+def test_a_study_scenario_runs_through_its_derivation_and_bad_study_fields_are_named(monkeypatch, tmp_path, capsys):
+    import numpy as np
+
+    from uvsym.derivation import Derivation, DerivationError
+    from uvsym.errors import ScenarioError
+    from uvsym.sim.result import Signal, SimResult
+
+    seen = {}
+
+    def simulate(table, name, progress, method=None):
+        gain = table.get("gain")
+        if not isinstance(gain, (int, float)) or gain <= 0:
+            raise ScenarioError(f"gain: expected a positive number, got {gain!r}")
+        seen.update(table=table, name=name, method=method)
+        t = np.linspace(0.0, 1.0, 5)
+        return SimResult(t, {"y": Signal(gain * t[:, None], ("y",), ("m",))}, {"wall_s": 0.01})
+
+    shipped = tmp_path / "toy_run.toml"
+    shipped.write_text('study = "toy"\ngain = 2.0\n')
+    toy = Derivation("toy", "Toy", lambda out_dir, progress: None, simulate=simulate, scenarios={"toy_run": shipped})
+    _install(monkeypatch, toy=toy)
+    assert main(["simulate", "--list"]) == 0
+    assert any(line.split()[:2] == ["toy_run", "toy"] for line in capsys.readouterr().out.splitlines())
+    assert main(["simulate", "toy_run", "--out", str(tmp_path / "run.npz")]) == 0
+    assert seen == {"table": {"gain": 2.0}, "name": "toy_run", "method": None}
+    assert (tmp_path / "run.npz").exists() and "study toy" in capsys.readouterr().out
+    bad = tmp_path / "bad.toml"
+    bad.write_text('study = "toy"\ngain = -1\n')
+    assert main(["simulate", str(bad)]) == 2
+    assert "gain: expected a positive number, got -1" in capsys.readouterr().err
+    bad.write_text('study = "nosuch"\n')
+    assert main(["simulate", str(bad)]) == 2
+    assert "study: unknown derivation 'nosuch'" in capsys.readouterr().err
+    with pytest.raises(DerivationError, match="ships scenarios but has no simulate"):
+        Derivation("x", "X", lambda out_dir, progress: None, scenarios={"a": shipped})

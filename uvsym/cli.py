@@ -124,29 +124,75 @@ def _cmd_report(args) -> int:
     return 0
 
 
-def _cmd_simulate(args) -> int:
+def _scenario_path(source: str) -> Path:
+    """A scenario file, or the file of a shipped scenario (uvsym's or a derivation's) named ``source``."""
+    from uvsym.derivation import study_scenarios
+    from uvsym.sim.scenario import shipped_scenarios
+
+    path = Path(source)
+    if path.exists():
+        return path
+    shipped = {**shipped_scenarios(), **{name: file for name, (_, file) in study_scenarios().items()}}
+    if source not in shipped:
+        raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
+                               f"shipped: {', '.join(sorted(shipped))}")
+    return shipped[source]
+
+
+def _simulate_study(study_name, table: dict, name: str, method: str | None):
+    """Run a derivation's scenario (top-level ``study = NAME``) with a progress bar."""
+    from uvsym.errors import ScenarioError
     from uvsym.progress import ProgressBar
-    from uvsym.sim.scenario import load_scenario, shipped_scenarios
+
+    if not isinstance(study_name, str):
+        raise ScenarioError(f"study: expected the name of a derivation, got {study_name!r}")
+    try:
+        study = derivation(study_name)
+    except UnknownNameError as exc:
+        raise ScenarioError(f"study: {exc}") from None
+    if study.simulate is None:
+        raise ScenarioError(f"study: derivation {study_name!r} runs no scenarios")
+    bar = ProgressBar(f"{name} ({study_name})")
+    result = study.simulate(table, name=name, progress=bar, method=method)
+    bar.close()
+    print(f"{name}: study {study_name}, {result.t[-1] - result.t[0]:g} s, "
+          f"{result.meta.get('wall_s', float('nan')):.3g} s wall; signals: {', '.join(result.signals)}")
+    return result
+
+
+def _cmd_simulate(args) -> int:
+    from uvsym.derivation import study_scenarios
+    from uvsym.progress import ProgressBar
+    from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
     from uvsym.sim.simulation import simulate_scenario
 
     if args.list or not args.scenario:
-        rows = [[name, str(path.name)] for name, path in shipped_scenarios().items()]
-        print(_table(rows, ["shipped scenario", "file"]))
+        rows = [[name, "", str(path.name)] for name, path in shipped_scenarios().items()]
+        rows += [[name, study, str(path.name)] for name, (study, path) in study_scenarios().items()]
+        print(_table(rows, ["shipped scenario", "study", "file"]))
         return 0
-    scenario = load_scenario(args.scenario)
-    bar = ProgressBar(f"{scenario.name} ({args.method})")
-    result = simulate_scenario(scenario, method=args.method, progress=bar)
-    bar.close()
-    wall = result.meta["wall_s"]
-    print(f"{scenario.name}: {scenario.model.name}, {scenario.duration:g} s at {scenario.step:g} s, method "
-          f"{args.method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
-          f"build {result.meta['build_s']:.2f} s")
-    x = result["x"]
-    print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
+    path = _scenario_path(args.scenario)
+    table = read_scenario_file(path)
+    if "study" in table:
+        table = dict(table)
+        result = _simulate_study(table.pop("study"), table, path.stem, args.method)
+        name = path.stem
+    else:
+        scenario = parse_scenario(table, default_name=path.stem)
+        method = args.method or "fast"
+        bar = ProgressBar(f"{scenario.name} ({method})")
+        result = simulate_scenario(scenario, method=method, progress=bar)
+        bar.close()
+        wall, name = result.meta["wall_s"], scenario.name
+        print(f"{scenario.name}: {scenario.model.name}, {scenario.duration:g} s at {scenario.step:g} s, method "
+              f"{method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
+              f"build {result.meta['build_s']:.2f} s")
+        x = result["x"]
+        print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out)}")
     if args.plot is not None:
-        figure = Path(args.plot or (Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name}.svg"))
+        figure = Path(args.plot or (Path(args.out).with_suffix(".svg") if args.out else f"{name}.svg"))
         result.plot(figure)
         print(f"wrote {figure}")
     return 0
@@ -245,7 +291,7 @@ def _parser() -> argparse.ArgumentParser:
 
     simulate = sub.add_parser("simulate", help="run a scenario (a TOML file or a shipped example's name)")
     simulate.add_argument("scenario", nargs="?", help="scenario file or shipped name (none: list the shipped ones)")
-    simulate.add_argument("--method", choices=METHODS, default="fast",
+    simulate.add_argument("--method", choices=METHODS, default=None,
                           help="fast (compiled fixed-step RK4, default) or a CasADi integrator")
     simulate.add_argument("--out", help="write the result (.npz, .csv or .mat)")
     simulate.add_argument("--plot", nargs="?", const="", default=None,

@@ -15,7 +15,11 @@ What a derivation implements:
   :class:`~uvsym.verify.certificate.Certificate`, each with the status it is expected to have
   (a negative control expects ``"refuted"``);
 - ``observer_sets``, optional: set name -> factory that takes keyword options with defaults
-  (``vehicle``, ``form``, ...) and returns an :class:`~uvsym.codegen.observer_sets.ObserverSet`.
+  (``vehicle``, ``form``, ...) and returns an :class:`~uvsym.codegen.observer_sets.ObserverSet`;
+- ``simulate``, optional: ``simulate(table, name=..., progress=..., method=None) -> SimResult`` runs
+  a scenario of this study given as the parsed TOML ``table`` (without its ``study`` key); it
+  validates every field and raises :class:`~uvsym.errors.ScenarioError` naming the field;
+- ``scenarios``, optional: shipped example scenario name -> TOML path (each with ``study = NAME``).
 
 What it gets for free:
 
@@ -23,7 +27,9 @@ What it gets for free:
 - ``uvsym verify NAME``: the claims checked and tabulated, ``reports/NAME/proofs.json``, exit
   status 1 when a claim is not as expected;
 - ``uvsym codegen SET -o DIR [--vehicle V] [--form F] [--float]``: the set as a C99 package,
-  options passed to the factory only when given; ``uvsym codegen --list`` lists every set.
+  options passed to the factory only when given; ``uvsym codegen --list`` lists every set;
+- ``uvsym simulate FILE.toml`` for a TOML whose top-level ``study = NAME`` names it (``--out``,
+  ``--plot`` as for every scenario), and its shipped scenarios in ``uvsym simulate --list``.
 
 Paper-specific numbers (vehicles, gains, faults, the paper's values) belong in the derivation;
 nothing in ``uvsym`` imports one.
@@ -42,10 +48,11 @@ from uvsym.codegen.observer_sets import ObserverSet, make_observer_set
 from uvsym.errors import DerivationError, UnknownNameError
 
 if TYPE_CHECKING:
+    from uvsym.sim.result import SimResult
     from uvsym.verify.certificate import Certificate
 
 __all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivations", "observer_set",
-           "observer_sets"]
+           "observer_sets", "study_scenarios"]
 
 GROUP = "uvsym.derivations"
 
@@ -59,17 +66,26 @@ class Derivation:
     build: Callable[[Path, Callable[[str], None]], None]
     claims: Callable[[], list[Certificate]] | None = None
     observer_sets: Mapping[str, Callable[..., ObserverSet]] = field(default_factory=dict)
+    simulate: Callable[..., SimResult] | None = None
+    scenarios: Mapping[str, Path] = field(default_factory=dict)
 
     def __post_init__(self):
         if not isinstance(self.observer_sets, Mapping):
             raise DerivationError(f"derivation {self.name!r}: observer_sets must map set names to factories, "
                                   f"got {type(self.observer_sets).__name__}")
+        if not isinstance(self.scenarios, Mapping):
+            raise DerivationError(f"derivation {self.name!r}: scenarios must map names to TOML paths, "
+                                  f"got {type(self.scenarios).__name__}")
+        if self.scenarios and self.simulate is None:
+            raise DerivationError(f"derivation {self.name!r}: ships scenarios but has no simulate")
         parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
+                 **({} if self.simulate is None else {"simulate": self.simulate}),
                  **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}
         bad = [part for part, f in parts.items() if not callable(f)]
         if bad:
             raise DerivationError(f"derivation {self.name!r}: not callable: {', '.join(bad)}")
         object.__setattr__(self, "observer_sets", MappingProxyType(dict(self.observer_sets)))
+        object.__setattr__(self, "scenarios", MappingProxyType({k: Path(v) for k, v in self.scenarios.items()}))
 
 
 def _entry_points() -> dict[str, EntryPoint]:
@@ -121,3 +137,14 @@ def observer_set(name: str, **options) -> ObserverSet:
     if name not in available:
         raise UnknownNameError(f"unknown observer set {name!r}; known: {', '.join(available) or 'none declared'}")
     return make_observer_set(name, available[name][1], **options)
+
+
+def study_scenarios() -> dict[str, tuple[str, Path]]:
+    """Every scenario the installed derivations ship: name -> (derivation name, TOML path)."""
+    found: dict[str, tuple[str, Path]] = {}
+    for study in load_derivations().values():
+        for name, path in study.scenarios.items():
+            if name in found:
+                raise DerivationError(f"scenario {name!r} is shipped by both {found[name][0]!r} and {study.name!r}")
+            found[name] = (study.name, path)
+    return dict(sorted(found.items()))

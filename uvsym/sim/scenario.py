@@ -22,7 +22,8 @@ from uvsym.models.registry import vehicle
 from uvsym.observers import FORMS, KINDS
 from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
 
-__all__ = ["Scenario", "ObserverSpec", "load_scenario", "parse_scenario", "shipped_scenarios"]
+__all__ = ["Scenario", "ObserverSpec", "load_scenario", "parse_scenario", "read_scenario_file",
+           "shipped_scenarios"]
 
 _PROFILE_KEYS = ("profile", "onset", "end", "duration", "rate", "period", "duty")
 
@@ -134,6 +135,17 @@ def shipped_scenarios() -> dict[str, Path]:
     return {Path(str(p)).stem: Path(str(p)) for p in sorted(folder.iterdir(), key=str) if str(p).endswith(".toml")}
 
 
+def read_scenario_file(path) -> dict:
+    """The parsed TOML table of the scenario file ``path``; ScenarioError when it cannot be read or parsed."""
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"{path}: cannot be read: {exc}") from None
+
+
 def load_scenario(source) -> Scenario:
     """Read and validate a scenario from a TOML file path or the name of a shipped example."""
     path = Path(source)
@@ -143,11 +155,7 @@ def load_scenario(source) -> Scenario:
             raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
                                    f"shipped: {', '.join(shipped)}")
         path = shipped[str(source)]
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    return parse_scenario(data, default_name=path.stem)
+    return parse_scenario(read_scenario_file(path), default_name=path.stem)
 
 
 def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
