@@ -275,7 +275,15 @@ def _cmd_verify(args) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="uvsym", description=__doc__)
+    parser = argparse.ArgumentParser(
+        prog="uvsym", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Vehicle dynamics and fault-diagnosis observers built symbolically in CasADi:\n"
+                    "inspect the models, simulate scenarios, build the derivation reports, check their\n"
+                    "claims by machine and write observers as C.",
+        epilog="examples:\n  uvsym models show remus100\n  uvsym simulate docking_faults --out run.npz --plot\n"
+               "  uvsym report actuator-observers\n  uvsym verify --json\n"
+               "  uvsym codegen actuator-observers -o c_out --vehicle otter3dof\n"
+               "'uvsym COMMAND --help' gives each command's options.")
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     models = sub.add_parser("models", help="list the vehicles and plants, or show one")

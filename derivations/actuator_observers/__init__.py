@@ -1,4 +1,4 @@
-"""The core paper's actuator-fault diagnosis and fault-tolerant control, reproduced (seeds/000).
+"""Actuator-fault diagnosis and fault-tolerant control of Liu et al. 2014 (:mod:`derivations.papers`), reproduced.
 
 ``uvsym report actuator-observers`` runs the docking experiment and its second case
 (:mod:`.experiment`, text in :mod:`.report`, figures in :mod:`.figures`); ``uvsym verify
@@ -10,13 +10,14 @@ and the targets of the reproduction are in :mod:`.paper`.
 from derivations.actuator_observers.claims import core_paper_claims
 from derivations.actuator_observers.experiment import build
 from derivations.actuator_observers.observer_sets import actuator_observers
+from derivations.papers import paper
 from uvsym.derivation import Derivation
 
 __all__ = ["DERIVATION"]
 
 DERIVATION = Derivation(
     name="actuator-observers",
-    title="Actuator-fault diagnosis and fault-tolerant control (core paper, seeds/000)",
+    title=f"Actuator-fault diagnosis and fault-tolerant control ({paper('liu2014').short})",
     build=build,
     claims=core_paper_claims,
     observer_sets={"actuator-observers": actuator_observers},

@@ -1,4 +1,4 @@
-"""The core paper's claims, checked by machine (Theorems 1-3, Remark 2, section 3.2), with negative controls.
+"""Liu et al. 2014's claims, checked by machine (Theorems 1-3, Remark 2, section 3.2), with negative controls.
 
 Theorems 1-3: the derived error dynamics against the paper's closed forms, and convergence over
 sets of desired actions by LMI (:mod:`uvsym.verify.observers`). Section 3.2 argues with a generic

@@ -1,4 +1,4 @@
-"""The docking experiment of the core paper (section 4) and its second case, run and written.
+"""The docking experiment of Liu et al. 2014 (section 4) and its second case, run and written.
 
 Runs the docking experiment (scenario ``docking_faults``) without and with correction, and a
 second case on the 6-DOF REMUS 100 (scenario ``remus100_stern_plane_bias``). Writes

@@ -1,4 +1,4 @@
-"""What the core paper (seeds/000) reports, what its reproduction must meet, and uvsym's choices.
+"""What Liu et al. 2014 reports, what its reproduction must meet, and uvsym's choices.
 
 Every number of the study that is not computed lives here.
 """

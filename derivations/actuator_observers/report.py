@@ -5,6 +5,7 @@ from __future__ import annotations
 import casadi as ca
 
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
+from derivations.papers import paper
 from uvsym.report import markdown_table
 from uvsym.report.sections import c_section, claims_table, counterexamples
 from uvsym.sim.scenario import Scenario
@@ -12,6 +13,8 @@ from uvsym.sim.simulation import scenario_observers
 from uvsym.sympy_bridge import latex
 
 __all__ = ["report"]
+
+LIU = paper("liu2014")
 
 
 def _fmt(value, digits: int = 6) -> str:
@@ -77,9 +80,11 @@ def report(scenario: Scenario, r: dict, checks: dict) -> str:
     dropped = ", ".join(f"{k} {_fmt(v, 3)}" for k, v in r["error_dynamics"]["dropped_term_rms"].items())
     fault_lines = "\n".join(f"    - {scenario.model.input_labels[f.actuator]}: {f.kind} {f.value:g} from t = "
                             f"{f.profile.onset:g} s" for f in scenario.actuator_faults)
-    return f"""# Actuator-fault diagnosis and fault-tolerant control (core paper, seeds/000)
+    return f"""# Actuator-fault diagnosis and fault-tolerant control ({LIU.short})
 
-Reproduction of the docking experiment of section 4: the docking AUV (`{scenario.model.name}`) follows a
+Paper: {LIU.reference()}
+
+Reproduction of the docking experiment of its section 4: the docking AUV (`{scenario.model.name}`) follows a
 planned path into a dock with a thruster bias and a rudder proportional fault present from the start;
 proportional and bias observers run together, and isolation, identification and correction act in the
 loop. Every number below is computed by `uvsym report actuator-observers`.
