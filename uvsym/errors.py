@@ -19,6 +19,7 @@ __all__ = [
     "CodegenError",
     "VerificationError",
     "DerivationError",
+    "CovarianceError",
 ]
 
 
@@ -80,3 +81,8 @@ class UnknownNameError(UvsymError, KeyError):
 
     def __str__(self) -> str:  # KeyError quotes its argument; keep the message readable
         return str(self.args[0]) if self.args else ""
+
+
+class CovarianceError(ObserverError):
+    """A covariance is not symmetric positive definite: an argument (``P0``, ``Q``, ``R``, named)
+    or a filter's own covariance during a run (names the filter, the sample and its time)."""
