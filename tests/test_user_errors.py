@@ -127,3 +127,85 @@ def test_shared_plants_cannot_be_changed_by_one_user():
     with pytest.raises(ValueError):
         motor.x_op[0] = 99.0
     assert uvsym.plant("otter", rp=np.array([0.05, 0.0, -0.3])).name == "otter"  # an array override is hashed
+
+
+# --- Functions of a Model, System or Observer are called through a checked layer -----------------
+
+def test_model_functions_name_the_argument_and_agree_with_the_raw_function():
+    from uvsym.errors import ArgumentError, KinematicsError
+
+    model = uvsym.vehicle("docking_auv")
+    x, u = np.linspace(0.1, 1.2, 12), np.array([10.0, 0.1, -0.1, 0.05])
+    assert isinstance(model.f, ca.Function) and not isinstance(model.f.raw, type(model.f))
+    np.testing.assert_array_equal(np.asarray(model.f(x, u, [0.2, 0.3])), np.asarray(model.f.raw(x, u, [0.2, 0.3])))
+    np.testing.assert_array_equal(np.asarray(model.f(x=x, u=u, p=[0.2, 0.3])["x_dot"]),
+                                  np.asarray(model.f.raw(x, u, [0.2, 0.3])))
+    with pytest.raises(ArgumentError, match=r"docking_auv.f: argument x has 11 entries .* expected 12"):
+        model.f(x[:11], u, [0.0, 0.0])
+    with pytest.raises(ArgumentError, match="unknown argument 'uu'; its arguments are x, u, p"):
+        model.f(x=x, uu=u, p=[0.0, 0.0])
+    with pytest.raises(ArgumentError, match=r"takes 3 arguments \(x, u, p\), got 2"):
+        model.f(x, u)
+    with pytest.raises(ArgumentError, match="argument nu entry v is nan"):
+        model.nu_dot(x[:6], [1.0, np.nan, 0, 0, 0, 0], u, 0.0, 0.0)
+    with pytest.raises(ArgumentError, match="argument u has 0 entries"):  # CasADi would read [] as zeros
+        model.tau(x[:6], x[6:], [], 0.0, 0.0)
+    with pytest.raises(ArgumentError, match="argument eta has 6 entries \\(shape \\(2, 3\\)\\)"):
+        model.B(np.ones((2, 3)), x[6:], u, 0.0, 0.0)
+    with pytest.raises(ArgumentError, match="argument u must be numbers"):
+        model.f(x, "thrust", [0.0, 0.0])
+    pitched_up = x.copy()
+    pitched_up[4] = math.pi / 2  # J(eta) is singular: the raw Function gives ~1e15 here
+    assert np.abs(np.asarray(model.f.raw(pitched_up, u, [0.0, 0.0]))).max() > 1e12
+    with pytest.raises(KinematicsError, match="docking_auv.f: x entry theta.*singular at theta = 90 deg"):
+        model.f(pitched_up, u, [0.0, 0.0])
+    symbolic = model.f(ca.SX.sym("x", 12), u, [0.0, 0.0])  # symbolic calls are not checked
+    assert isinstance(symbolic, ca.SX) and symbolic.shape == (12, 1)
+
+
+def test_system_and_observer_functions_are_checked_and_keep_their_api():
+    from uvsym.errors import ArgumentError
+    from uvsym.observers.base import observer
+
+    plant = _spring()
+    assert float(plant.f([1.0, 2.0], [0.5], [], [])[1]) == -1.0 - 1.0 + 0.5  # the hand-derived value
+    with pytest.raises(ArgumentError, match="spring.f: argument x entry vel is inf"):
+        plant.f([1.0, math.inf], [0.5], [], [])
+    with pytest.raises(ArgumentError, match="spring.h: argument u has 2 entries"):
+        plant.h([1.0, 2.0], [0.5, 0.1], [])
+    with pytest.raises(ArgumentError, match=r"root.f: output x_dot entry vel is nan at finite arguments"):
+        system("root", "sqrt", x=X, u=U, rhs=lambda x, u, d, p: [x[1], ca.sqrt(x[0])]).f([-1.0, 0.0], [0.0], [], [])
+    obs = observer("o", step=lambda s, y, u, p: (0.5 * s + y, s), state=signals(("a", "-")),
+                   reads_y=signals(("b", "-")), reads_u=signals(), publishes=signals(("c", "-")), dt=0.1)
+    s_next, out = obs.step([1.0], [2.0], [], [])
+    assert float(s_next) == 2.5 and float(out) == 1.0
+    with pytest.raises(ArgumentError, match="o.o_step: argument y entry b is nan"):
+        obs.step([1.0], [math.nan], [], [])
+    with pytest.raises(ArgumentError, match="unknown argument 'why'"):
+        obs.step(s=[1.0], why=[2.0], u=[], p=[])
+    S, _ = obs.run(np.ones((3, 1)), np.zeros((3, 0)), s0=[0.0])  # runs on the unchecked Function
+    np.testing.assert_allclose(S.ravel(), [0.0, 1.0, 1.5, 1.75])
+
+
+def test_actuator_observers_and_gain_design_refuse_the_wrong_objects():
+    from uvsym.errors import ArgumentError
+    from uvsym.observers import actuator_observer
+    from uvsym.observers.gains import design_gains
+
+    with pytest.raises(ObserverError, match=r"model must be a uvsym Model, got str .*uvsym.vehicle\('otter3dof'\)"):
+        actuator_observer("otter3dof", "bias")
+    model = uvsym.vehicle("otter3dof")
+    obs = actuator_observer(model, "proportional", form="momentum")
+    with pytest.raises(ObserverError, match="pass the observer, not its .function"):
+        design_gains(obs.function, 1.0, [1.0, 1.0, 1.0])
+    with pytest.raises(ObserverError, match="zero in every channel.*Remark 2"):
+        design_gains(obs, 1.0, [0.0, 0.0, 0.0])
+    with pytest.raises(ObserverError, match="tau_d must have 3 finite entries"):
+        design_gains(obs, 1.0, [1.0, math.nan, 1.0])
+    with pytest.raises(ObserverError, match="time_constant must be positive"):
+        design_gains(obs, "1", [1.0, 1.0, 1.0])
+    design = design_gains(obs, 2.0, [100.0, 0.0, 5.0])  # momentum form: rate k_i tau_d,i^2 (hand derivation)
+    assert design.unobservable == (1,)
+    np.testing.assert_allclose(design.K[[0, 2]], [1 / (2.0 * 100.0**2), 1 / (2.0 * 5.0**2)])
+    with pytest.raises(ArgumentError, match="otter3dof.proportional_observer: argument K has 2 entries"):
+        obs.function(np.zeros(3), np.zeros(3), np.zeros(3), np.ones(3), np.ones(2))

@@ -17,9 +17,16 @@ __all__ = [
     "ObserverError",
     "WiringError",
     "CodegenError",
+    "PrecisionError",
     "VerificationError",
     "DerivationError",
     "CovarianceError",
+    "ArgumentError",
+    "PathError",
+    "FileFormatError",
+    "SetError",
+    "SetDivergenceError",
+    "UIOConditionError",
 ]
 
 
@@ -86,3 +93,45 @@ class UnknownNameError(UvsymError, KeyError):
 class CovarianceError(ObserverError):
     """A covariance is not symmetric positive definite: an argument (``P0``, ``Q``, ``R``, named)
     or a filter's own covariance during a run (names the filter, the sample and its time)."""
+
+
+class ArgumentError(UvsymError, ValueError):
+    """A Model's, System's or Observer's Function was called with an argument of the wrong size,
+    an unknown name or non-finite values, or gives non-finite outputs there (names the argument
+    and the entry)."""
+
+
+class PathError(UvsymError, OSError):
+    """A file or folder cannot be written or read as asked: missing, not a folder, not writable, an
+    existing file not to be overwritten, or a folder holding files uvsym did not write (names the path)."""
+
+
+class FileFormatError(UvsymError, ValueError):
+    """A file's content is not what uvsym writes in that format (names the path and what is wrong)."""
+
+
+class StepSizeWarning(UserWarning):
+    """An adaptive filter's step size is at or beyond its stability bound (the message gives the bound)."""
+
+
+class SetError(UvsymError, ValueError):
+    """A set operation cannot be done as asked (non-conforming sizes, a non-finite or negative bound,
+    a reduction order below the dimension); the message names the argument."""
+
+
+class SetDivergenceError(SetError):
+    """A propagated enclosure keeps growing past a sound bound (an unstable map, or reduction wrapping)."""
+
+
+class UIOConditionError(ObserverError):
+    """An unknown-input observer does not exist for the matrices given: ``rank(C D) != rank(D)`` or
+    ``(C, T A)`` not detectable; ``ranks`` and ``eigenvalues`` hold the evidence."""
+
+    def __init__(self, message: str, *, ranks: tuple[int, int] | None = None, eigenvalues: tuple = ()):
+        super().__init__(message)
+        self.ranks = ranks
+        self.eigenvalues = tuple(eigenvalues)
+
+
+class PrecisionError(CodegenError):
+    """A single-precision C build strays too far from double precision on its example data (names the figure)."""

@@ -16,9 +16,17 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from uvsym.conventions import FORCE_UNITS, POSITION_LABELS, POSITION_UNITS, VELOCITY_LABELS, VELOCITY_UNITS
-from uvsym.errors import ModelError
-from uvsym.kinematics import J, Rzyx
+from uvsym.checked import checked
+from uvsym.conventions import (
+    FORCE_LABELS,
+    FORCE_UNITS,
+    POSITION_LABELS,
+    POSITION_UNITS,
+    VELOCITY_LABELS,
+    VELOCITY_UNITS,
+)
+from uvsym.errors import KinematicsError, ModelError
+from uvsym.kinematics import J, Rzyx, Tzyx
 from uvsym.models.hydrodynamics import current_velocity, current_velocity_derivative
 from uvsym.models.parameters import ParameterSet
 from uvsym.systems.signals import Signals
@@ -48,7 +56,8 @@ class VehicleEquations:
 
 @dataclass(frozen=True)
 class Model:
-    """A frozen vehicle model. Functions take (and name) their arguments as below.
+    """A frozen vehicle model. Functions take (and name) their arguments as below; numeric calls
+    are checked (sizes, names, finite values: :mod:`uvsym.checked`, ``.raw`` unchecked).
 
     nu_dot(eta, nu, u, V_c, beta_c) -> nu_dot; f(x, u, p) -> x_dot with x = [eta; nu],
     p = [V_c, beta_c]; tau(eta, nu, u, V_c, beta_c) -> tau; h(eta, nu) -> h (no current);
@@ -187,6 +196,13 @@ def assemble(name: str, description: str, dof: int, parameters: ParameterSet, eq
         raise ModelError(f"{name}: actuation gives shape {tau.shape}, expected ({dof}, 1)")
     nu_dot = current_velocity_derivative(V_c, beta_c, psi, r, dof) + ca.mtimes(ca.DM(np.linalg.inv(M)), tau - h)
     eta_dot = ca.mtimes(J(eta), nu) if dof == 6 else ca.mtimes(Rzyx(0.0, 0.0, psi), nu)
+    states = POSITION_LABELS[dof] + VELOCITY_LABELS[dof]
+    labels = {"eta": POSITION_LABELS[dof], "nu": VELOCITY_LABELS[dof], "x": states, "x_dot": states,
+              "u": tuple(eq.input_labels), "u_cmd": tuple(eq.input_labels), "tau": FORCE_LABELS[dof],
+              "h": FORCE_LABELS[dof], "nu_dot": VELOCITY_LABELS[dof]}
+
+    def check(function: ca.Function, guard=None) -> ca.Function:
+        return checked(function, name, labels, guard)
 
     env, env_names = [V_c, beta_c], ["V_c", "beta_c"]
     h_still = ca.substitute(h, ca.vertcat(V_c, beta_c), ca.DM.zeros(2))
@@ -205,13 +221,29 @@ def assemble(name: str, description: str, dof: int, parameters: ParameterSet, eq
         input_units=tuple(eq.input_units),
         u_min=np.asarray(eq.u_min, dtype=float),
         u_max=np.asarray(eq.u_max, dtype=float),
-        nu_dot=nu_dot_fn,
-        f=ca.Function("f", [x, u, p], [x_dot], ["x", "u", "p"], ["x_dot"]),
-        tau=ca.Function("tau", [eta, nu, u, *env], [tau], ["eta", "nu", "u", *env_names], ["tau"]),
-        h=ca.Function("h", [eta, nu], [h_still], ["eta", "nu"], ["h"]),
-        B=ca.Function("B", [eta, nu, u, *env], [ca.jacobian(tau, u)], ["eta", "nu", "u", *env_names], ["B"]),
-        actuator_rate=ca.Function("actuator_rate", [u, u_cmd], [eq.actuator_rate(u, u_cmd)],
-                                  ["u", "u_cmd"], ["u_dot"]),
-        terms=ca.Function("terms", [eta, nu, *env], list(terms.values()), ["eta", "nu", *env_names], list(terms)),
+        nu_dot=check(nu_dot_fn),
+        f=check(ca.Function("f", [x, u, p], [x_dot], ["x", "u", "p"], ["x_dot"]),
+                _attitude_guard(name) if dof == 6 else None),
+        tau=check(ca.Function("tau", [eta, nu, u, *env], [tau], ["eta", "nu", "u", *env_names], ["tau"])),
+        h=check(ca.Function("h", [eta, nu], [h_still], ["eta", "nu"], ["h"])),
+        B=check(ca.Function("B", [eta, nu, u, *env], [ca.jacobian(tau, u)], ["eta", "nu", "u", *env_names], ["B"])),
+        actuator_rate=check(ca.Function("actuator_rate", [u, u_cmd], [eq.actuator_rate(u, u_cmd)],
+                                        ["u", "u_cmd"], ["u_dot"])),
+        terms=check(ca.Function("terms", [eta, nu, *env], list(terms.values()), ["eta", "nu", *env_names],
+                                list(terms))),
         term_names=tuple(terms),
     )
+
+
+def _attitude_guard(name: str):
+    """A guard for ``f(x, u, p)`` of a 6-DOF model: KinematicsError where eta' = J(eta) nu is
+    singular (theta = +-90 deg, :func:`~uvsym.kinematics.Tzyx`), which would otherwise give 1e15."""
+
+    def guard(values: dict) -> None:
+        x = values["x"]
+        try:
+            Tzyx(*(x[3:5] if x.size > 4 else (x[0], x[0])))
+        except KinematicsError as exc:
+            raise KinematicsError(f"{name}.f: x entry theta: {exc}") from None
+
+    return guard

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from uvsym.checked import checked
+from uvsym.conventions import FORCE_LABELS, POSITION_LABELS, VELOCITY_LABELS
 from uvsym.errors import ObserverError
 from uvsym.faults import ActuatorKind, actuator_kind
 from uvsym.models.model import Model
@@ -72,10 +74,13 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
     Raises
     ------
     ObserverError
-        For an unknown kind or form, or the paper's proportional observer on a model whose M is
-        not diagonal (Assumption 1; its error dynamics need not converge there: use
-        ``form="momentum"``).
+        For a model that is not a :class:`Model` (e.g. its name), an unknown kind or form, or the
+        paper's proportional observer on a model whose M is not diagonal (Assumption 1; its error
+        dynamics need not converge there: use ``form="momentum"``).
     """
+    if not isinstance(model, Model):
+        hint = f" (build it with uvsym.vehicle({model!r}))" if isinstance(model, str) else ""
+        raise ObserverError(f"model must be a uvsym Model, got {type(model).__name__} {model!r:.40}{hint}")
     if kind not in KINDS:
         raise ObserverError(f"unknown observer kind {kind!r}; known: {', '.join(KINDS)}")
     if form not in FORMS:
@@ -110,13 +115,20 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
     e_dot = (-ca.substitute(x_dot, x, f - e + R) + ca.mtimes(L, plant_nu_dot)
              + ca.mtimes(ca.jacobian(R, tau_d), tau_d_dot))
     A = ca.mtimes(LM, G)
+    forces = FORCE_LABELS[n]
+    labels = {"x": forces, "eta": POSITION_LABELS[n], "nu": VELOCITY_LABELS[n], "tau_d": forces, "K": forces,
+              "x_dot": forces, "f_hat": forces, "e": forces, "f": forces, "tau_d_dot": forces, "e_dot": forces}
+
+    def check(fn: ca.Function) -> ca.Function:  # numeric calls checked (uvsym.checked); .raw unchecked
+        return checked(fn, model.name, labels)
+
     return ActuatorObserver(
-        kind=kind, form=form, model_name=model.name, function=function,
-        R=ca.Function("R", [nu, tau_d, K], [R], ["nu", "tau_d", "K"], ["R"]),
-        L=ca.Function("L", [nu, tau_d, K], [L], ["nu", "tau_d", "K"], ["L"]),
-        error_matrix=ca.Function("A", [tau_d, K], [A], ["tau_d", "K"], ["A"]),
-        error_dynamics=ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K], [e_dot],
-                                   ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"], ["e_dot"]),
+        kind=kind, form=form, model_name=model.name, function=check(function),
+        R=check(ca.Function("R", [nu, tau_d, K], [R], ["nu", "tau_d", "K"], ["R"])),
+        L=check(ca.Function("L", [nu, tau_d, K], [L], ["nu", "tau_d", "K"], ["L"])),
+        error_matrix=check(ca.Function("A", [tau_d, K], [A], ["tau_d", "K"], ["A"])),
+        error_dynamics=check(ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K], [e_dot],
+                                         ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"], ["e_dot"])),
     )
 
 

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from uvsym.checked import checked
 from uvsym.errors import ObserverError
 from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
@@ -47,7 +48,8 @@ STEP_OUTPUTS = ("s_next", "out")
 class Observer:
     """A discrete-time estimator (module docstring).
 
-    step(s, y, u, p) -> (s_next, out); state, reads_y, reads_u, params, publishes: the Signals of
+    step(s, y, u, p) -> (s_next, out) (numeric calls checked: :mod:`uvsym.checked`; ``step.raw``
+    unchecked); state, reads_y, reads_u, params, publishes: the Signals of
     s, y, u, p and out; p0: (n_p,) default parameters; dt: sample period (s); init(y0, u0, p) ->
     s0 (None: zeros); error_dynamics: symbolic error dynamics for verify, or None; equations:
     further named Functions a report may render (e.g. the continuous right-hand side).
@@ -96,6 +98,9 @@ class Observer:
         except Exception as exc:
             raise ObserverError(str(exc)) from None
         object.__setattr__(self, "p0", p0)
+        labels = {"s": self.state.names, "y": self.reads_y.names, "u": self.reads_u.names, "p": self.params.names,
+                  "s_next": self.state.names, "out": self.publishes.names}
+        object.__setattr__(self, "step", checked(f, self.name, labels))  # numeric calls checked; .raw unchecked
 
     def parameters(self, p=None) -> np.ndarray:
         """The parameter vector: ``p0``, or p (array or ``{name: value}``) checked against ``params``."""

@@ -46,18 +46,36 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
 
     tau_d: (n,) nominal desired action, needed by the proportional observer (its rate scales with
     tau_d,i^2); unobservable channels (Remark 2) get the gain 1 and are listed, not divided by zero.
+
+    Raises
+    ------
+    ObserverError
+        For something other than an :class:`ActuatorObserver` (e.g. its ``.function``), a time
+        constant that is not positive and finite, a tau_d of the wrong size or not finite, or a
+        tau_d that leaves every channel unobservable (all zero for the proportional observer).
     """
-    if not time_constant > 0.0 or not np.isfinite(time_constant):
-        raise ObserverError(f"time_constant must be positive and finite (s), got {time_constant}")
+    if not isinstance(observer, ActuatorObserver):
+        raise ObserverError(f"design_gains takes the ActuatorObserver that actuator_observer() returns, got "
+                            f"{type(observer).__name__} (pass the observer, not its .function)")
+    if isinstance(time_constant, bool) or not isinstance(time_constant, (int, float, np.floating)) or \
+            not time_constant > 0.0 or not np.isfinite(time_constant):
+        raise ObserverError(f"time_constant must be positive and finite (s), got {time_constant!r}")
     n = observer.function.size1_in("x")
     if tau_d is None:
         if actuator_kind(observer.kind).scales:
             raise ObserverError(f"the {observer.kind} observer's rate depends on tau_d: pass the nominal tau_d")
         tau_d = np.ones(n)
-    tau_d = np.asarray(tau_d, dtype=float).ravel()
-    if tau_d.size != n:
-        raise ObserverError(f"tau_d must have {n} entries, got {tau_d.size}")
+    try:
+        tau_d = np.asarray(tau_d, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ObserverError(f"tau_d must be {n} numbers (N, N m), got {tau_d!r:.60}") from None
+    if tau_d.size != n or not np.all(np.isfinite(tau_d)):
+        raise ObserverError(f"tau_d must have {n} finite entries, got {tau_d.tolist()}")
     unobservable = unobservable_channels(observer, tau_d)
+    if len(unobservable) == n:
+        raise ObserverError(f"tau_d = {tau_d.tolist()} is zero in every channel: the {observer.kind} observer sees "
+                            "no fault in any of them (Remark 2: a fault scaling tau_d,i is invisible where tau_d,i "
+                            "= 0); give the nominal desired action of the run")
     per_unit_gain = -np.diag(np.asarray(observer.error_matrix(tau_d, np.ones(n))))
     K = np.ones(n)
     for i in range(n):

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from uvsym.checked import checked
 from uvsym.errors import ModelError
 from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
@@ -50,7 +51,9 @@ class Linearization:
 
 @dataclass(frozen=True)
 class System:
-    """A plant. ``f(x, u, d, p) -> x_dot`` (or ``x_next`` when ``dt`` is set), ``h(x, u, p) -> y``.
+    """A plant. ``f(x, u, d, p) -> x_dot`` (or ``x_next`` when ``dt`` is set), ``h(x, u, p) -> y``;
+    numeric calls of f and h are checked (sizes, names, finite values: :mod:`uvsym.checked`), ``.raw``
+    unchecked.
 
     p0: (n_p,) nominal parameter values; x_op, u_op: an operating point (default zeros) used as
     the default of :meth:`linearize` and as a sensible initial state; u_min, u_max: input bounds
@@ -83,6 +86,10 @@ class System:
         out = "x_next" if self.discrete else "x_dot"
         _check_function(self.name, self.f, ARGUMENTS, sizes, {out: self.x.size})
         _check_function(self.name, self.h, ("x", "u", "p"), sizes, {"y": self.y.size})
+        labels = {"x": self.x.names, "u": self.u.names, "d": self.d.names, "p": self.p.names, out: self.x.names,
+                  "y": self.y.names}
+        for attr in ("f", "h"):  # numeric calls checked (uvsym.checked); .raw unchecked
+            object.__setattr__(self, attr, checked(getattr(self, attr), self.name, labels))
         if self.dt is not None and not (np.isfinite(self.dt) and self.dt > 0):
             raise ModelError(f"{self.name}: sample period dt must be positive and finite (s), got {self.dt}")
         object.__setattr__(self, "p0", self.p.vector(self.p0, f"{self.name}: nominal parameters p0"))
