@@ -1,0 +1,94 @@
+"""The heading loop of the LMS-FIR compass-fault paper, with uvsym's choices where it is silent.
+
+Paper (Zhu Daqi et al., seed 001): FIR order M = 70 (L165-167), LMS step mu = 0.01 (L183),
+sample period 0.2 s (L563), heading set-point 150 deg (L515), compass faults of +30, +20, +10
+deg added to the measurement at sample 70 (L511-519). Not in the paper (uvsym's choices, stated
+in the report): the vehicle (``rov_yaw``, a VideoRay Pro III yaw proxy), the controller, the
+thresholds eps0 and r0, the R window n, the noise, the run length and the initial weights.
+
+The loop: a set-point table publishes ``psi_ref``; a proportional heading controller (the
+paper's PID with ``ki = kd = 0``: an integral winds up on the faulty samples before the fault is
+confirmed and then turns the vehicle open loop, see the report) reads ``psi`` and publishes
+``u``; the LMS-FIR monitor reads ``psi``, ``u`` and ``psi_ref``. Its gain gives the loop of the
+linearised yaw model ``psi / u = K / (s (T s + 1))`` the natural frequency ``BANDWIDTH``
+(``K kp = T BANDWIDTH^2``; damping ratio ``1 / (2 T BANDWIDTH)``, 1.4: no overshoot). A seeded
+white yaw torque and compass noise excite the loop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+import uvsym
+from uvsym.observers.base import Observer
+from uvsym.observers.lms import lms_monitor
+from uvsym.sim import observer_block
+from uvsym.sim.feedback import open_loop, pid
+from uvsym.systems.signals import signals
+from uvsym.systems.system import System
+
+__all__ = ["Design", "design", "DT", "ORDER", "MU", "SET_POINT_DEG", "EPS0_DEG2", "R0", "WINDOW", "HOLD", "CONFIRM",
+           "BANDWIDTH", "COMPASS_NOISE_DEG", "TORQUE_NOISE", "WARM_UP", "RECORD", "FAULT_SAMPLE", "FAULT_SIZES_DEG"]
+
+# the paper's numbers
+DT = 0.2  # s (L563)
+ORDER = 70  # M (L165-167)
+MU = 0.01  # LMS step, per unit of u squared (L183)
+SET_POINT_DEG = 150.0  # (L515)
+FAULT_SAMPLE = 70  # recorded sample of the fault's onset (L553)
+FAULT_SIZES_DEG = (30.0, 20.0, 10.0)  # (L519)
+# uvsym's choices (not in the paper)
+EPS0_DEG2 = 9.0  # eps^2 threshold, (3 deg)^2: the paper's FTC tolerance
+R0 = 9.0  # R threshold: a squared z-score of 3
+WINDOW = 20  # n, samples in R's window (4 s)
+HOLD = 3  # samples R must stay above r0: one large update (a one-sample disturbance) gives R = n - 1 once
+CONFIRM = 10  # samples R has to confirm an eps^2 alarm (2 s)
+BANDWIDTH = 0.7  # rad/s, natural frequency of the linearised heading loop
+COMPASS_NOISE_DEG = 0.5  # standard deviation of the compass noise
+TORQUE_NOISE = 1e-4  # N m, standard deviation of the white yaw torque (held over each sample)
+WARM_UP = 500  # samples before the record starts (100 s): the filter trains on the healthy loop
+RECORD = 400  # samples recorded (80 s): the fault at 70 leaves 66 s after it
+
+
+@dataclass(frozen=True)
+class Design:
+    """plant (rov_yaw), monitor (the LMS-FIR Observer), kp (1/rad) and the loop's blocks."""
+
+    plant: System
+    monitor: Observer
+    kp: float
+    blocks: tuple
+
+
+def heading_gain(plant: System, bandwidth: float = BANDWIDTH) -> float:
+    """kp (per rad) of ``u = kp (psi_ref - psi)``: the linearised loop's natural frequency is ``bandwidth`` (rad/s)."""
+    lin = plant.linearize()
+    T = -1.0 / lin.A[1, 1]  # s, yaw time constant m66 / |N_r|
+    K = lin.B[1, 0] * T  # rad/s per unit u
+    return T * bandwidth ** 2 / K
+
+
+def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0: float = R0, window: int = WINDOW,
+           hold: int = HOLD, confirm: int = CONFIRM, set_point_deg: float = SET_POINT_DEG) -> Design:
+    """The plant, the monitor and the heading loop's blocks (ObserverError for bad monitor settings)."""
+    plant = uvsym.plant("rov_yaw")
+    monitor = lms_monitor(plant.y, plant.u, reference=signals(("psi_ref", "rad", "heading set-point")),
+                          order=order, mu=mu, eps0=_positive_deg2(eps0_deg2), r0=r0, dt=DT, window=window,
+                          hold=hold, confirm=confirm, name="lms")
+    kp = heading_gain(plant)
+    reference = open_loop("reference", [0.0], [math.radians(set_point_deg)], publishes=["psi_ref"])
+    controller = pid("heading", "psi", "psi_ref", output="u", kp=kp, limits=(-1.0, 1.0), dt=DT)
+    return Design(plant, monitor, kp, (reference, controller, observer_block(monitor)))
+
+
+def _positive_deg2(value: float) -> float:
+    """deg^2 -> rad^2 (the monitor checks the sign and names eps0)."""
+    return float(value) * (math.pi / 180.0) ** 2 if isinstance(value, (int, float)) else value
+
+
+def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:
+    """(samples + 1, 1) white yaw torque (N m), seeded."""
+    return sigma * np.random.default_rng(seed).standard_normal((samples + 1, 1))
