@@ -8,14 +8,22 @@ from pathlib import Path
 
 from uvsym.verify.certificate import Certificate
 
-__all__ = ["assert_proved", "assert_refuted", "assert_same_folder", "assert_same_text"]
+__all__ = ["assert_checked", "assert_proved", "assert_refuted", "assert_same_folder", "assert_same_text"]
 
 
 def assert_proved(certificate: Certificate) -> None:
-    """AssertionError (with the method and the reason) unless the claim was proved."""
+    """AssertionError (with the method and the reason) unless the claim was proved rigorously
+    (numerical evidence, status ``checked``, is not a proof and fails)."""
     if certificate.status != "proved":
         raise AssertionError(f"not proved: {certificate.claim} over {certificate.set} by {certificate.method}: "
                              f"{certificate.status} {certificate.reason}".rstrip())
+
+
+def assert_checked(certificate: Certificate) -> None:
+    """AssertionError unless the claim was checked numerically (sampled, not proved, not refuted)."""
+    if certificate.status != "checked":
+        raise AssertionError(f"not checked: {certificate.claim} by {certificate.method}: {certificate.status} "
+                             f"{certificate.reason}".rstrip())
 
 
 def assert_refuted(certificate: Certificate) -> None:

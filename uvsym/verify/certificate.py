@@ -5,16 +5,25 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from uvsym.errors import VerificationError
+
 __all__ = ["STATUSES", "Certificate"]
 
-STATUSES = ("proved", "refuted", "inconclusive")
+STATUSES = ("proved", "checked", "refuted", "inconclusive")
 
 
 @dataclass(frozen=True)
 class Certificate:
-    """One checked claim. ``status`` is proved, refuted (with a ``counterexample``) or inconclusive
-    (with the ``reason``); ``expected`` is the status the claim should have (negative controls
-    expect refuted); ``margin`` how far from failing (method-specific, stated in ``method``)."""
+    """One checked claim. ``status`` says what was shown:
+
+    - ``proved``: a rigorous argument (exact rationals, or outward-rounded intervals) over the whole set;
+    - ``checked``: numerical evidence only (e.g. sampling at N points of the set, stated in ``method``),
+      never counted as a proof;
+    - ``refuted``: a ``counterexample``, re-checked rigorously (exact arithmetic or interval bounds);
+    - ``inconclusive``: neither, with the ``reason``.
+
+    ``expected`` is the status the claim should have (negative controls expect refuted); ``margin``
+    how far from failing (method-specific, stated in ``method``)."""
 
     claim: str
     set: str
@@ -30,7 +39,12 @@ class Certificate:
     def __post_init__(self):
         for name in ("status", "expected"):
             if getattr(self, name) not in STATUSES:
-                raise ValueError(f"certificate {name} must be one of {STATUSES}, got {getattr(self, name)!r}")
+                raise VerificationError(f"certificate {name} must be one of {STATUSES}, got {getattr(self, name)!r}")
+
+    @property
+    def proved(self) -> bool:
+        """True only for a rigorous proof (``checked`` evidence is not one)."""
+        return self.status == "proved"
 
     @property
     def as_expected(self) -> bool:
@@ -50,7 +64,8 @@ class Certificate:
             point = ", ".join(f"{name} = {value:.{digits}g}" for name, value in example["x"].items())
             return f"at {point}: V' = {example['V_dot']:.{digits}g} > {example['bound']:.{digits}g}"
         if "relative_difference" in example:
-            return f"the two sides differ by {example['relative_difference']:.{digits}g} (relative) at a random point"
+            return (f"the two sides differ by {example['relative_difference']:.{digits}g} (relative to the size of "
+                    f"their terms) at a sampled point")
         return ""
 
     def to_dict(self) -> dict:

@@ -3,15 +3,21 @@
 ``IntervalFunction(f)`` replays ``f``'s instruction list (the same graph CasADi evaluates and
 generates C from) on intervals: each work variable holds (k,) lower and upper bounds, one
 entry per box, so a batch of boxes costs one numpy operation per instruction. Every rounded
-operation moves its bounds outward by one unit in the last place (``numpy.nextafter``);
+operation moves its bounds outward by one unit in the last place (``numpy.nextafter``), overflow
+included (a bound that overflows to inf moves back to the largest double on the inner side);
 IEEE +, -, *, / and sqrt are correctly rounded, so that encloses the exact result; results
-that are exact anyway (sums whose TwoSum error is 0, and 0 * x, 0 / x) stay unwidened, so that
-an equilibrium evaluates to exactly 0. Library
-functions (exp, sin, tanh, ...) are accurate to within an ulp in glibc; they are widened by
-``LIBM_ULPS`` units, except that the odd ones vanishing at 0 (sin, tanh, atan, sinh, asinh,
-expm1, log1p) give exactly 0 for an argument that is exactly 0 (IEEE signed zeros, exact).
-The enclosure is therefore rigorous: every value the function takes on a box lies between the
-bounds returned for it.
+that are exact anyway (sums whose TwoSum error is 0, 2 x without overflow, and 0 * x, 0 / x)
+stay unwidened, so that an equilibrium evaluates to exactly 0. Integer powers go by repeated
+squaring of intervals (each step outward-rounded). Library functions (exp, sin, tanh, ...) are
+accurate to within an ulp or two; they are widened by ``LIBM_ULPS`` units, except where their
+value is exact: at an argument that is exactly 0, sin, tanh, atan, sinh, asinh, expm1, log1p
+give 0 and exp, cos, cosh give 1. The enclosure is therefore rigorous: every value the
+function takes on a box lies between the bounds returned for it.
+
+``defined`` says, per box, whether every operation's argument stays in its domain (sqrt of
+x >= 0, log of x > 0, log1p of x > -1, division by an interval without 0, a non-integer power of
+x >= 0). Where it may not, the operation's bounds are the whole real line and the box is
+"undefined": never provable, and reported as such by the callers.
 
 ``smooth`` says, per box, whether no non-smooth operation (abs, min/max, comparisons,
 conditionals, sign, floor) has its kink inside the box; Taylor-type arguments need it.
@@ -26,19 +32,19 @@ import numpy as np
 
 from uvsym.errors import VerificationError
 
-__all__ = ["IntervalFunction", "Intervals"]
+__all__ = ["IntervalFunction", "Intervals", "round_down", "round_up"]
 
-LIBM_ULPS = 2
+LIBM_ULPS = 4
 _NAMES = {getattr(ca, name): name[3:].lower() for name in dir(ca) if name.startswith("OP_")}
 
 
-def _down(x, ulps: int = 1):
+def round_down(x, ulps: int = 1):
     for _ in range(ulps):
         x = np.nextafter(x, -np.inf)
     return x
 
 
-def _up(x, ulps: int = 1):
+def round_up(x, ulps: int = 1):
     for _ in range(ulps):
         x = np.nextafter(x, np.inf)
     return x
@@ -53,10 +59,18 @@ def _is_zero(a):
     return (a[0] == 0) & (a[1] == 0)
 
 
-def _exact_zeros(result, a, b=None):
-    """``result`` with exact zeros where an operand is exactly 0 (no rounding to widen there)."""
+def _exact_zeros(result, a, b=None, value: float = 0.0):
+    """``result`` with the exact ``value`` where an operand is exactly 0 (no rounding to widen there)."""
     zero = _is_zero(a) if b is None else _is_zero(a) | _is_zero(b)
-    return np.where(zero, 0.0, result[0]), np.where(zero, 0.0, result[1])
+    return np.where(zero, value, result[0]), np.where(zero, value, result[1])
+
+
+def _twice(a):
+    """2 a: exact, except where it overflows (a bound of inf from a finite one moves inward)."""
+    with np.errstate(over="ignore"):
+        lo, hi = 2.0 * a[0], 2.0 * a[1]
+    return (np.where(np.isposinf(lo) & np.isfinite(a[0]), np.finfo(float).max, lo),
+            np.where(np.isneginf(hi) & np.isfinite(a[1]), -np.finfo(float).max, hi))
 
 
 def _rounded_sum(x, y, direction: float):
@@ -83,14 +97,19 @@ def _mul(a, b):
     with np.errstate(invalid="ignore"):
         products = np.stack([a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]])
     products = np.where(np.isnan(products), 0.0, products)  # 0 * inf: a zero factor wins
-    return _exact_zeros((_down(products.min(axis=0)), _up(products.max(axis=0))), a, b)
+    return _exact_zeros((round_down(products.min(axis=0)), round_up(products.max(axis=0))), a, b)
+
+
+def _holds_zero(b):
+    return (b[0] <= 0.0) & (b[1] >= 0.0)
 
 
 def _div(a, b):
-    straddles = (b[0] <= 0.0) & (b[1] >= 0.0)
+    """a / b; where b holds 0 the box is undefined (the caller marks it) and the bounds unbounded."""
     with np.errstate(all="ignore"):
         quotients = np.stack([a[0] / b[0], a[0] / b[1], a[1] / b[0], a[1] / b[1]])
-    lo, hi = _clean(_down(quotients.min(axis=0)), _up(quotients.max(axis=0)))  # inf/inf: unbounded
+    lo, hi = _exact_zeros(_clean(round_down(quotients.min(axis=0)), round_up(quotients.max(axis=0))), a)  # inf/inf: unbounded
+    straddles = _holds_zero(b)
     return np.where(straddles, -np.inf, lo), np.where(straddles, np.inf, hi)
 
 
@@ -104,7 +123,7 @@ def _even(a, function):
 def _increasing(function, ulps: int = LIBM_ULPS):
     def apply(a):
         with np.errstate(all="ignore"):
-            return _clean(_down(function(a[0]), ulps), _up(function(a[1]), ulps))
+            return _clean(round_down(function(a[0]), ulps), round_up(function(a[1]), ulps))
     return apply
 
 
@@ -112,7 +131,7 @@ def _periodic(a, function, peak: float, trough: float):
     """sin or cos: endpoint values, and +-1 where the box holds a peak or a trough."""
     with np.errstate(all="ignore"):
         f0, f1 = function(a[0]), function(a[1])
-    lo, hi = _down(np.minimum(f0, f1), LIBM_ULPS), _up(np.maximum(f0, f1), LIBM_ULPS)
+    lo, hi = round_down(np.minimum(f0, f1), LIBM_ULPS), round_up(np.maximum(f0, f1), LIBM_ULPS)
     two_pi = 2.0 * np.pi
     slack = 1e-9  # rounding of the peak positions: when in doubt the box holds one
     holds_peak = np.floor((a[1] - peak) / two_pi + slack) >= np.ceil((a[0] - peak) / two_pi - slack)
@@ -147,22 +166,52 @@ def _compare(op, a, b):
     return _indicator(disjoint, point_equal)
 
 
+def _square(a):
+    lo, hi = _even(a, np.square)
+    return _exact_zeros(_clean(round_down(lo), round_up(hi)), a)
+
+
 def _power(a, exponent: float):
-    if exponent == int(exponent):
-        n = int(exponent)
-        if n == 0:
-            return np.ones_like(a[0]), np.ones_like(a[0])
-        if n < 0:
-            return _div((np.ones_like(a[0]), np.ones_like(a[0])), _power(a, -n))
-        if n % 2 == 0:
-            lo, hi = _even(a, lambda x: x**n)
-        else:
-            lo, hi = a[0] ** n, a[1] ** n
-        return _clean(_down(lo, n), _up(hi, n))
-    if np.any(a[0] < 0):
-        raise VerificationError(f"interval power x^{exponent} needs x >= 0 on every box")
-    lo, hi = (a[0] ** exponent, a[1] ** exponent) if exponent > 0 else (a[1] ** exponent, a[0] ** exponent)
-    return _clean(_down(lo, LIBM_ULPS), _up(hi, LIBM_ULPS))
+    """a^exponent for a finite constant exponent: integers by repeated squaring (outward at each
+    step), others through the library pow (needs a >= 0, > 0 for a negative exponent)."""
+    ones = (np.ones_like(a[0]), np.ones_like(a[0]))
+    if exponent == np.floor(exponent):
+        n = abs(int(exponent))
+        result, base = ones, a
+        while n:
+            if n & 1:
+                result = _mul(result, base)
+            n >>= 1
+            if n:
+                base = _square(base)
+        return _div(ones, result) if exponent < 0 else result
+    if exponent > 0:
+        lo, hi = np.maximum(a[0], 0.0) ** exponent, np.maximum(a[1], 0.0) ** exponent
+    else:
+        with np.errstate(divide="ignore"):
+            lo, hi = np.maximum(a[1], 0.0) ** exponent, np.maximum(a[0], 0.0) ** exponent
+    return _clean(round_down(lo, LIBM_ULPS), round_up(hi, LIBM_ULPS))
+
+
+def _outside_domain(op: int, args) -> np.ndarray | None:
+    """(k,) True where the operation's argument may leave its domain; None for total operations."""
+    a = args[0]
+    if op == ca.OP_SQRT:
+        return a[0] < 0
+    if op == ca.OP_LOG:
+        return a[0] <= 0
+    if op == ca.OP_LOG1P:
+        return a[0] <= -1
+    if op == ca.OP_DIV:
+        return _holds_zero(args[1])
+    if op == ca.OP_INV:
+        return _holds_zero(a)
+    if op in (ca.OP_CONSTPOW, ca.OP_POW):
+        exponent = float(args[1][0][0]) if len(args[1][0]) else 0.0
+        if exponent == np.floor(exponent):
+            return _holds_zero(a) if exponent < 0 else None
+        return a[0] <= 0 if exponent < 0 else a[0] < 0
+    return None
 
 
 _MONOTONE = {
@@ -171,15 +220,18 @@ _MONOTONE = {
 }
 _POSITIVE_DOMAIN = {ca.OP_LOG: np.log, ca.OP_SQRT: np.sqrt}
 _ZERO_AT_ZERO = {ca.OP_SIN, ca.OP_TANH, ca.OP_ATAN, ca.OP_SINH, ca.OP_ASINH, ca.OP_EXPM1, ca.OP_LOG1P}
+_ONE_AT_ZERO = {ca.OP_EXP, ca.OP_COS, ca.OP_COSH}
 
 
 @dataclass(frozen=True)
 class Intervals:
-    """Bounds of a function's outputs over k boxes: lo, hi (k, m); smooth (k,) as in the module docstring."""
+    """Bounds of a function's outputs over k boxes: lo, hi (k, m); smooth and defined (k,) as in the
+    module docstring (bounds of an undefined box are meaningless)."""
 
     lo: np.ndarray
     hi: np.ndarray
     smooth: np.ndarray
+    defined: np.ndarray
 
 
 class IntervalFunction:
@@ -222,21 +274,32 @@ class IntervalFunction:
         k = lo.shape[0]
         work: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         out_lo, out_hi = np.zeros((k, self.n_out)), np.zeros((k, self.n_out))
-        smooth = np.ones(k, dtype=bool)
+        smooth, defined = np.ones(k, dtype=bool), np.ones(k, dtype=bool)
         for op, inputs, outputs, constant in self.program:
             if op == ca.OP_INPUT:
                 work[outputs[0]] = (lo[:, inputs[1]], hi[:, inputs[1]])
             elif op == ca.OP_OUTPUT:
                 out_lo[:, outputs[1]], out_hi[:, outputs[1]] = work[inputs[0]]
             elif op == ca.OP_CONST:
-                work[outputs[0]] = (np.full(k, constant), np.full(k, constant))
+                if not np.isfinite(constant):
+                    defined[:] = False
+                work[outputs[0]] = _clean(np.full(k, constant), np.full(k, constant))
             else:
                 args = [work[i] for i in inputs]
-                result, kink = self._apply(op, args)
+                with np.errstate(all="ignore"):
+                    result, kink = self._apply(op, args)
                 if kink is not None:
                     smooth &= ~kink
-                work[outputs[0]] = _exact_zeros(result, args[0]) if op in _ZERO_AT_ZERO else result
-        return Intervals(out_lo, out_hi, smooth)
+                if op in _ZERO_AT_ZERO:
+                    result = _exact_zeros(result, args[0])
+                elif op in _ONE_AT_ZERO:
+                    result = _exact_zeros(result, args[0], value=1.0)
+                outside = _outside_domain(op, args)
+                if outside is not None:
+                    defined &= ~outside
+                    result = (np.where(outside, -np.inf, result[0]), np.where(outside, np.inf, result[1]))
+                work[outputs[0]] = _clean(*result)
+        return Intervals(out_lo, out_hi, smooth, defined)
 
     def _apply(self, op: int, args):
         """(lo, hi) of one operation, and where its kink lies inside the box (None for smooth ones)."""
@@ -251,33 +314,30 @@ class IntervalFunction:
         if op == ca.OP_MUL:
             return _mul(a, b), None
         if op == ca.OP_DIV:
-            return _exact_zeros(_div(a, b), a), None
+            return _div(a, b), None
         if op == ca.OP_INV:
             return _div((np.ones_like(a[0]), np.ones_like(a[0])), a), None
         if op == ca.OP_NEG:
             return (-a[1], -a[0]), None
         if op == ca.OP_TWICE:
-            return (2.0 * a[0], 2.0 * a[1]), None
+            return _twice(a), None
         if op == ca.OP_SQ:
-            lo, hi = _even(a, np.square)
-            return _exact_zeros(_clean(_down(lo), _up(hi)), a), None
+            return _square(a), None
         if op == ca.OP_COSH:
             lo, hi = _even(a, np.cosh)
-            return _clean(_down(lo, LIBM_ULPS), _up(hi, LIBM_ULPS)), None
+            return _clean(round_down(lo, LIBM_ULPS), round_up(hi, LIBM_ULPS)), None
         if op in _MONOTONE:
             return _increasing(_MONOTONE[op])(a), None
-        if op in _POSITIVE_DOMAIN:
-            if np.any(a[1] < 0 if op == ca.OP_SQRT else a[1] <= 0):
-                raise VerificationError(f"interval {_NAMES[op]} of an argument outside its domain on a box")
-            clipped = (np.maximum(a[0], 0.0), a[1])
+        if op in _POSITIVE_DOMAIN:  # boxes reaching outside the domain are marked undefined by the caller
+            clipped = (np.maximum(a[0], 0.0), np.maximum(a[1], 0.0))
             return _increasing(_POSITIVE_DOMAIN[op], 1 if op == ca.OP_SQRT else LIBM_ULPS)(clipped), None
         if op == ca.OP_SIN:
             return _periodic(a, np.sin, np.pi / 2, -np.pi / 2), None
         if op == ca.OP_COS:
             return _periodic(a, np.cos, 0.0, np.pi), None
         if op in (ca.OP_CONSTPOW, ca.OP_POW):
-            if not np.all(b[0] == b[1]) or not np.all(b[0] == b[0][0]):
-                raise VerificationError("interval power needs a constant exponent")
+            if not np.all(b[0] == b[1]) or not np.all(b[0] == b[0][0]) or not np.all(np.isfinite(b[0])):
+                raise VerificationError("interval power needs a constant, finite exponent")
             return _power(a, float(b[0][0])), None
         if op == ca.OP_FABS:
             kink = (a[0] < 0) & (a[1] > 0)

@@ -4,7 +4,8 @@ For ``e' = (A - L C) e`` a decay rate alpha holds with ``V = e^T P e`` when
 ``(A - L C)^T P + P (A - L C) + 2 alpha P < 0``; with ``Y = P L`` this is linear in (P, Y):
 ``A^T P + P A - C^T Y^T - Y C + 2 alpha P < 0``. Optional equality constraints ``E P = F`` (the
 unknown-input observer's ``(P L) ... = ...`` conditions) enter as they are. The gain returned
-is ``L = P^-1 Y``, and the closed loop ``A - L C`` is re-certified by :func:`lyapunov_decrease`
+is ``L = P^-1 Y``, and the closed loop ``A - L C`` -- computed exactly in rationals from the doubles
+A, L and C, not the floating-point ``fl(A - L C)`` -- is re-certified by :func:`lyapunov_decrease`
 independently of the solver.
 """
 
@@ -16,8 +17,9 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from uvsym.errors import UvsymError
+from uvsym.errors import UvsymError, VerificationError
 from uvsym.verify.certificate import Certificate
+from uvsym.verify.exact import as_fraction_matrix, matmul
 from uvsym.verify.lyapunov import lyapunov_decrease
 
 __all__ = ["DESIGN_MARGIN", "GainSynthesis", "synthesize_observer_gain"]
@@ -50,14 +52,13 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
         For non-finite or wrongly sized A or C, a decay that is negative or not finite, an LMI
         without a solution, or a gain that the exact re-check cannot certify.
     """
-    A, C = np.atleast_2d(np.asarray(A, dtype=float)), np.atleast_2d(np.asarray(C, dtype=float))
+    A_exact, C_exact = as_fraction_matrix(A, "A"), as_fraction_matrix(C, "C")
+    A, C = np.array(A_exact, dtype=float), np.array(C_exact, dtype=float)
     n, p = A.shape[0], C.shape[0]
     if A.shape != (n, n) or C.shape[1] != n:
-        raise UvsymError(f"A must be square and C have {n} columns; got A {A.shape}, C {C.shape}")
-    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(C))):
-        raise UvsymError("A and C must be finite")
-    if not (np.isfinite(decay) and decay >= 0):
-        raise UvsymError(f"decay must be a finite rate >= 0 (1/s), got {decay}")
+        raise VerificationError(f"A must be square and C have {n} columns; got A {A.shape}, C {C.shape}")
+    if not (isinstance(decay, (int, float, np.floating, np.integer)) and np.isfinite(decay) and decay >= 0):
+        raise VerificationError(f"decay must be a finite rate >= 0 (1/s), got {decay!r}")
     tried = []
     for design in (DESIGN_MARGIN * decay + 1e-6, decay):  # with room to spare; else exactly the rate asked
         P, Y = cp.Variable((n, n), symmetric=True), cp.Variable((n, p))
@@ -74,7 +75,10 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
     else:
         raise UvsymError(f"no observer gain with decay {decay} 1/s: the LMI at {' and at '.join(tried)}")
     L = np.linalg.solve(P.value, Y.value)
-    certificate = lyapunov_decrease(claim, [A - L @ C], decay, f"A - L C with the synthesised L, decay {decay:g} 1/s")
+    L_exact = as_fraction_matrix(L, "L")
+    closed_loop = [[a - lc for a, lc in zip(row_a, row_lc)] for row_a, row_lc in zip(A_exact, matmul(L_exact, C_exact))]
+    certificate = lyapunov_decrease(claim, [closed_loop], decay,
+                                    f"A - L C (exact, in rationals) with the synthesised L, decay {decay:g} 1/s")
     if certificate.status != "proved":
         raise UvsymError(f"the synthesised gain could not be certified at decay {decay:g} 1/s "
                          f"({certificate.status}: {certificate.reason or certificate.method})")
