@@ -17,7 +17,7 @@ from uvsym import __version__
 from uvsym.derivation import Derivation, derivation, load_derivations, observer_set, observer_sets
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
-from uvsym.paths import output_folder
+from uvsym.paths import claim_folder, output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["main"]
@@ -110,8 +110,9 @@ def _cmd_report(args) -> int:
 
     selected = _selected(args.names)
     out_root = output_folder(args.out, "reports")
-    for index, study in enumerate(selected, 1):
-        out_dir = out_root / study.name
+    out_dirs = [claim_folder(out_root / study.name, f"the {study.name} report", "report", args.force)
+                for study in selected]  # every folder checked before any study runs
+    for index, (study, out_dir) in enumerate(zip(selected, out_dirs), 1):
         out_dir.mkdir(parents=True, exist_ok=True)
 
         def progress(message: str, _name=study.name, _index=index) -> None:
@@ -163,6 +164,7 @@ def _simulate_study(study_name, table: dict, name: str, method: str | None):
 def _cmd_simulate(args) -> int:
     from uvsym.derivation import study_scenarios
     from uvsym.progress import ProgressBar
+    from uvsym.sim.result import SimResult
     from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
     from uvsym.sim.simulation import simulate_scenario
 
@@ -172,6 +174,8 @@ def _cmd_simulate(args) -> int:
         print(_table(rows, ["shipped scenario", "study", "file"]))
         return 0
     path = _scenario_path(args.scenario)
+    if args.out:  # format, folder and an existing file checked before the run
+        SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
     if "study" in table:
         table = dict(table)
@@ -190,7 +194,7 @@ def _cmd_simulate(args) -> int:
         x = result["x"]
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
-        print(f"wrote {result.save(args.out)}")
+        print(f"wrote {result.save(args.out, overwrite=args.force)}")
     if args.plot is not None:
         figure = Path(args.plot or (Path(args.out).with_suffix(".svg") if args.out else f"{name}.svg"))
         result.plot(figure)
@@ -212,6 +216,7 @@ def _cmd_codegen(args) -> int:
     options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
     options |= _set_options(args.name, factory, args.set_options)
     observers = observer_set(args.name, **options)
+    claim_folder(args.out, "the C package", "package", args.force)
     manifest = observers.write(args.out, "float" if args.float else "double")
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "
@@ -294,6 +299,7 @@ def _parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="build derivation reports (all, or the ones named)")
     report.add_argument("names", nargs="*", help="derivations to build (default: all)")
     report.add_argument("--out", default="reports", help="output folder (default: ./reports)")
+    report.add_argument("--force", action="store_true", help="write into folders holding files uvsym did not write")
     report.set_defaults(run=_cmd_report)
     from uvsym.sim.run import METHODS
 
@@ -305,12 +311,14 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", nargs="?", const="", default=None,
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
+    simulate.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     simulate.set_defaults(run=_cmd_simulate)
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "
                                              "a set's own options as --name value (uvsym codegen --list)")
     codegen.add_argument("name", nargs="?", help="observer set a derivation declares (none: list them)")
     codegen.add_argument("-o", "--out", help="output folder (needed with a set)")
     codegen.add_argument("--list", action="store_true", help="list the observer sets with their derivation")
+    codegen.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
     codegen.add_argument("--vehicle", help="vehicle of the library, for a set that takes one (default: the set's)")
     codegen.add_argument("--form", help="observer form, for a set that takes one (default: the set's)")
     codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi)")

@@ -1,35 +1,62 @@
 """SimResult: named, labelled, unit-carrying arrays of one simulation, with file I/O and plots.
 
-Formats (chosen by suffix): ``.npz`` (numpy), ``.csv`` (one column per entry, header
-``signal:label [unit]``, metadata as a ``#`` comment line), ``.mat`` (MATLAB, via scipy.io;
-signal names with ``/`` are stored with ``__``).
+Formats (chosen by suffix), each round-tripping every valid result exactly: ``.npz`` (numpy;
+``NAME:values`` arrays), ``.csv`` (one column per entry, header ``signal:label [unit]``),
+``.mat`` (MATLAB via scipy.io; each signal under a valid MATLAB variable name). Every file also
+holds ``meta`` and the ``layout`` (signal names, labels and units in order) as JSON (in the CSV,
+on its first line after ``#``), which is what loading reads.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import re
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import scipy.io
 
-from uvsym.errors import SimulationError, UnknownNameError
-from uvsym.paths import output_folder
+from uvsym.errors import FileFormatError, PathError, SimulationError, UnknownNameError
+from uvsym.paths import output_file
 
-__all__ = ["Signal", "SimResult"]
+__all__ = ["Signal", "SimResult", "FORMATS"]
 
 FORMATS = (".npz", ".csv", ".mat")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f\ud800-\udfff]")  # control characters, lone surrogates
+
+
+def _text(value, what: str, allow_empty: bool = True) -> str:
+    """``value`` if it is a string every format can hold (no control characters or lone surrogates);
+    SimulationError naming ``what``."""
+    if not isinstance(value, str) or _CONTROL.search(value) or (not allow_empty and not value):
+        raise SimulationError(f"{what} must be a{'' if allow_empty else ' non-empty'} string without control "
+                              f"characters, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)
 class Signal:
-    """values: (N, k) array; labels and units: k entries each."""
+    """values: (N, k) array; labels and units: k strings each (no control characters)."""
 
     values: np.ndarray
     labels: tuple[str, ...]
     units: tuple[str, ...]
+
+    def __post_init__(self):
+        values = np.asarray(self.values, dtype=float)
+        labels, units = tuple(self.labels), tuple(self.units)
+        if values.ndim != 2 or values.shape[1] != len(labels) or len(units) != len(labels):
+            raise SimulationError(f"a signal needs (N, k) values with k labels and k units, got values "
+                                  f"{values.shape}, {len(labels)} labels, {len(units)} units")
+        for i, (label, unit) in enumerate(zip(labels, units)):
+            _text(label, f"label {i}")
+            _text(unit, f"unit of {label!r}")
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "labels", labels)
+        object.__setattr__(self, "units", units)
 
     def __getitem__(self, label: str) -> np.ndarray:
         """The (N,) column of one entry, by label."""
@@ -42,85 +69,72 @@ class Signal:
 class SimResult:
     """t: (N,) s; signals: name -> Signal (x, y, u_desired, u_command, u_expected, u_actual,
     fault_actuator, fault_sensor, tau_desired, reference, f_hat/<observer>; see ``simulate``);
-    meta: JSON-friendly description of the run."""
+    meta: JSON-friendly description of the run. Names are non-empty strings without control
+    characters; every signal has one row per time."""
 
     t: np.ndarray
     signals: dict[str, Signal]
     meta: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        t = np.asarray(self.t, dtype=float)
+        if t.ndim != 1:
+            raise SimulationError(f"t must be a 1-D array of times (s), got shape {t.shape}")
+        for name, sig in self.signals.items():
+            _text(name, "a signal name", allow_empty=False)
+            if not isinstance(sig, Signal) or sig.values.shape[0] != t.size:
+                raise SimulationError(f"signal {name!r} must be a Signal with one row per time ({t.size})")
+        try:
+            json.dumps(self.meta)
+        except (TypeError, ValueError) as exc:
+            raise SimulationError(f"meta must be JSON-friendly: {exc}") from None
+        object.__setattr__(self, "t", t)
 
     def __getitem__(self, name: str) -> Signal:
         if name not in self.signals:
             raise UnknownNameError(f"no signal {name!r}; signals: {', '.join(self.signals)}")
         return self.signals[name]
 
-    def save(self, path) -> Path:
-        """Write to ``path`` (its folder is made if missing); the suffix (.npz, .csv or .mat) picks the format."""
+    @staticmethod
+    def check_path(path, overwrite: bool = False) -> Path:
+        """``path`` checked before a run writes it: a known suffix (SimulationError), a writable
+        folder, no existing file unless ``overwrite`` (PathError)."""
         path = Path(path)
-        suffix = _suffix(path)
-        output_folder(path.parent, "the result", SimulationError).mkdir(parents=True, exist_ok=True)
-        if suffix == ".npz":
-            arrays = {"t": self.t, "meta": np.array(json.dumps(self.meta))}
-            for name, sig in self.signals.items():
-                arrays[f"{name}:values"] = sig.values
-                arrays[f"{name}:labels"] = np.array(sig.labels)
-                arrays[f"{name}:units"] = np.array(sig.units)
-            with path.open("wb") as handle:
-                np.savez_compressed(handle, **arrays)
-        elif suffix == ".csv":
-            header = ["t [s]"] + [f"{name}:{lab} [{unit}]" for name, sig in self.signals.items()
-                                  for lab, unit in zip(sig.labels, sig.units)]
-            table = np.column_stack([self.t] + [sig.values for sig in self.signals.values()])
-            with path.open("w", newline="") as handle:
-                handle.write("# " + json.dumps(self.meta) + "\n")
-                writer = csv.writer(handle)
-                writer.writerow(header)
-                writer.writerows([[repr(float(v)) for v in row] for row in table])
-        else:
-            content = {"t": self.t, "meta": json.dumps(self.meta),
-                       "signals": np.array(list(self.signals), dtype=object)}
-            for name, sig in self.signals.items():
-                key = _mat_key(name)
-                content[key] = sig.values
-                content[key + "_labels"] = np.array(sig.labels, dtype=object)
-                content[key + "_units"] = np.array(sig.units, dtype=object)
-            scipy.io.savemat(path, content, do_compression=True)
+        _suffix(path)
+        return output_file(path, "the result", overwrite)
+
+    def save(self, path, overwrite: bool = False) -> Path:
+        """Write to ``path`` (its folder is made if missing); the suffix (.npz, .csv or .mat) picks the
+        format. An existing file is kept (PathError) unless ``overwrite``."""
+        path = self.check_path(path, overwrite)
+        layout = [{"name": n, "labels": list(s.labels), "units": list(s.units)} for n, s in self.signals.items()]
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            _WRITERS[path.suffix](self, path, layout)
+        except OSError as exc:
+            raise PathError(f"cannot write the result to {path}: {exc.strerror or exc}") from None
         return path
 
     @classmethod
     def load(cls, path) -> SimResult:
-        """Read a file written by :meth:`save`."""
+        """Read a file written by :meth:`save`; PathError when it cannot be read, FileFormatError
+        when its content is not a result."""
         path = Path(path)
         suffix = _suffix(path)
-        if not path.exists():
-            raise SimulationError(f"no such result file: {path}")
-        if suffix == ".npz":
-            with np.load(path, allow_pickle=False) as data:
-                names = [key[:-len(":values")] for key in data.files if key.endswith(":values")]
-                signals = {name: Signal(data[f"{name}:values"], tuple(data[f"{name}:labels"].tolist()),
-                                        tuple(data[f"{name}:units"].tolist())) for name in names}
-                return cls(data["t"], signals, json.loads(str(data["meta"])))
-        if suffix == ".csv":
-            with path.open(newline="") as handle:
-                meta = json.loads(handle.readline()[2:])
-                rows = list(csv.reader(handle))
-            header, table = rows[0], np.array(rows[1:], dtype=float).reshape(-1, len(rows[0]))
-            columns: dict[str, list] = {}
-            for index, column in enumerate(header[1:], 1):
-                name_label, unit = column.rsplit(" [", 1)
-                name, label = name_label.rsplit(":", 1)
-                columns.setdefault(name, []).append((index, label, unit[:-1]))
-            signals = {name: Signal(table[:, [c[0] for c in cols]], tuple(c[1] for c in cols),
-                                    tuple(c[2] for c in cols)) for name, cols in columns.items()}
-            return cls(table[:, 0], signals, meta)
-        data = scipy.io.loadmat(path, simplify_cells=True)
-        names = [data["signals"]] if isinstance(data["signals"], str) else list(data["signals"])
-        signals = {}
-        for name in names:
-            key = _mat_key(name)
-            values = np.atleast_2d(data[key])
-            labels, units = np.atleast_1d(data[key + "_labels"]), np.atleast_1d(data[key + "_units"])
-            signals[name] = Signal(values.reshape(-1, len(labels)), tuple(map(str, labels)), tuple(map(str, units)))
-        return cls(np.atleast_1d(data["t"]).astype(float), signals, json.loads(data["meta"]))
+        if not path.is_file():
+            raise PathError(f"no such result file: {path}")
+        try:
+            t, arrays, meta, layout = _READERS[suffix](path)
+            signals = {}
+            for i, item in enumerate(layout):
+                values = np.asarray(arrays[i], dtype=float).reshape(t.size, len(item["labels"]))
+                signals[item["name"]] = Signal(values, tuple(item["labels"]), tuple(item["units"]))
+            return cls(t, signals, meta)
+        except OSError as exc:
+            raise PathError(f"cannot read {path}: {exc.strerror or exc}") from None
+        except (ValueError, KeyError, IndexError, TypeError, AttributeError, zipfile.BadZipFile,
+                NotImplementedError, scipy.io.matlab.MatReadError, SimulationError) as exc:
+            raise FileFormatError(f"{path} is not a result file uvsym wrote ({type(exc).__name__}: {exc})") from None
 
     def plot(self, path=None, names: tuple[str, ...] | None = None):
         """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``.
@@ -172,5 +186,76 @@ def _suffix(path: Path) -> str:
     return path.suffix
 
 
-def _mat_key(name: str) -> str:
-    return name.replace("/", "__")
+def _write_npz(result: SimResult, path: Path, layout: list) -> None:
+    arrays = {"t": result.t, "meta": np.array(json.dumps(result.meta)), "layout": np.array(json.dumps(layout))}
+    arrays |= {f"{name}:values": sig.values for name, sig in result.signals.items()}
+    with path.open("wb") as handle:
+        np.savez_compressed(handle, **arrays)
+
+
+def _read_npz(path: Path):
+    with np.load(path, allow_pickle=False) as data:
+        layout = json.loads(str(data["layout"]))
+        return (data["t"], [data[f"{item['name']}:values"] for item in layout], json.loads(str(data["meta"])),
+                layout)
+
+
+def _write_csv(result: SimResult, path: Path, layout: list) -> None:
+    header = ["t [s]"] + [f"{name}:{lab} [{unit}]" for name, sig in result.signals.items()
+                          for lab, unit in zip(sig.labels, sig.units)]
+    table = np.column_stack([result.t] + [sig.values for sig in result.signals.values()])
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        handle.write("# " + json.dumps({"meta": result.meta, "layout": layout}) + "\n")
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        writer.writerows([[repr(float(v)) for v in row] for row in table])
+
+
+def _read_csv(path: Path):
+    with path.open(newline="", encoding="utf-8") as handle:
+        first = handle.readline()
+        if not first.startswith("# "):
+            raise ValueError("the first line is not the '# {meta, layout}' comment")
+        head = json.loads(first[2:])
+        rows = list(csv.reader(handle))
+    layout, widths = head["layout"], [len(item["labels"]) for item in head["layout"]]
+    if not rows or len(rows[0]) != 1 + sum(widths):
+        raise ValueError(f"the header has {len(rows[0]) if rows else 0} columns, the layout {1 + sum(widths)}")
+    table = np.array(rows[1:], dtype=float).reshape(len(rows) - 1, 1 + sum(widths))
+    edges = np.cumsum([1] + widths)
+    return table[:, 0], [table[:, a:b] for a, b in zip(edges[:-1], edges[1:])], head["meta"], layout
+
+
+def _write_mat(result: SimResult, path: Path, layout: list) -> None:
+    keys = _mat_keys(list(result.signals))
+    layout = [{**item, "key": key} for item, key in zip(layout, keys)]
+    content = {"t": result.t, "meta": json.dumps(result.meta), "layout": json.dumps(layout)}
+    content |= {key: sig.values for key, sig in zip(keys, result.signals.values())}
+    scipy.io.savemat(path, content, do_compression=True)
+
+
+def _read_mat(path: Path):
+    data = scipy.io.loadmat(path, simplify_cells=True)
+    layout = json.loads(data["layout"])
+    return (np.asarray(data["t"], dtype=float).reshape(-1), [data[item["key"]] for item in layout],
+            json.loads(data["meta"]), layout)
+
+
+def _mat_keys(names: list[str]) -> list[str]:
+    """A distinct MATLAB variable name per signal (a letter, then letters, digits, _; <= 63 chars),
+    readable where the name allows (``f_hat/bias`` -> ``f_hat_bias``), never t, meta or layout."""
+    keys, taken = [], {"t", "meta", "layout"}
+    for name in names:
+        base = re.sub(r"[^A-Za-z0-9_]", "_", name)
+        base = (base if base[:1].isalpha() else "s_" + base)[:56]
+        key, count = base, 1
+        while key in taken:
+            count += 1
+            key = f"{base}_{count}"
+        taken.add(key)
+        keys.append(key)
+    return keys
+
+
+_WRITERS = {".npz": _write_npz, ".csv": _write_csv, ".mat": _write_mat}
+_READERS = {".npz": _read_npz, ".csv": _read_csv, ".mat": _read_mat}
