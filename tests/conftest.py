@@ -1,11 +1,52 @@
-"""Shared fixtures: the reference data and the vehicle library."""
+"""Shared fixtures: the reference data, the reports as committed and as built (once per session), a browser."""
 
+import io
 import json
+import shutil
+import subprocess
+import tarfile
 from pathlib import Path
 
 import pytest
 
-REFERENCE_FILE = Path(__file__).resolve().parents[1] / "derivations" / "data" / "fossen_pvs_reference.json"
+ROOT = Path(__file__).resolve().parents[1]
+REFERENCE_FILE = ROOT / "derivations" / "data" / "fossen_pvs_reference.json"
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: builds a whole report or runs a long study (deselect with -m 'not slow')")
+
+
+@pytest.fixture(scope="session")
+def committed_reports(tmp_path_factory) -> Path:
+    """reports/ as the last commit holds it (CI rebuilds the working tree's reports/ before the tests, so
+    comparing with the working tree would compare the build with itself); the working tree's outside git."""
+    if shutil.which("git") and (ROOT / ".git").exists():
+        listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "reports"], capture_output=True, text=True)
+        if listed.returncode == 0 and listed.stdout.strip():
+            archive = subprocess.run(["git", "-C", str(ROOT), "archive", "HEAD", "reports"], capture_output=True,
+                                     check=True)
+            out = tmp_path_factory.mktemp("committed")
+            with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
+                tar.extractall(out, **({"filter": "data"} if hasattr(tarfile, "data_filter") else {}))
+            return out / "reports"
+    return ROOT / "reports"
+
+
+@pytest.fixture(scope="session")
+def built_report(tmp_path_factory):
+    """``built_report(name)``: the folder ``uvsym report name`` writes, built once per session."""
+    from uvsym.cli import main
+
+    root, built = tmp_path_factory.mktemp("built"), {}
+
+    def build(name: str) -> Path:
+        if name not in built:
+            assert main(["report", name, "--out", str(root)]) == 0, f"uvsym report {name} failed"
+            built[name] = root / name
+        return built[name]
+
+    return build
 
 
 @pytest.fixture(scope="session")

@@ -9,7 +9,6 @@ import pytest
 
 import uvsym
 from uvsym.cli import main
-from uvsym.testing import assert_same_folder, assert_same_text
 
 
 def run(*args):
@@ -62,31 +61,25 @@ def test_unknown_names_exit_2_with_a_message(args):
     assert "uvsym: error:" in result.stderr and "Traceback" not in result.stderr
 
 
-def test_report_models_is_deterministic(tmp_path):
-    first, second = tmp_path / "a", tmp_path / "b"
-    assert main(["report", "models", "--out", str(first)]) == 0
-    assert main(["report", "models", "--out", str(second)]) == 0
-    names = sorted(p.name for p in (first / "models").iterdir())
+def test_report_models_is_deterministic(tmp_path, built_report):
+    first = built_report("models")
+    assert main(["report", "models", "--out", str(tmp_path)]) == 0
+    names = sorted(p.name for p in first.iterdir())
     assert names == ["report.html", "report.md", "results.json", "step_responses.svg"]
     for name in names:
-        assert (first / "models" / name).read_bytes() == (second / "models" / name).read_bytes(), name
-    results = json.loads((first / "models" / "results.json").read_text())
+        assert (first / name).read_bytes() == (tmp_path / "models" / name).read_bytes(), name
+
+
+def test_models_report_checks_the_reference_cases(built_report):
+    results = json.loads((built_report("models") / "results.json").read_text())
     assert results["reference_cases_passed"] == results["reference_cases"] == 13
     assert results["docking_auv_B_matches_eq27"] is True
 
 
-def test_committed_models_report_is_current(tmp_path):
-    """The committed reports/models text files are what the current code builds."""
-    committed = Path(__file__).resolve().parents[1] / "reports" / "models"
-    assert main(["report", "models", "--out", str(tmp_path)]) == 0
-    for name in ("report.md", "report.html", "results.json"):
-        assert_same_text((tmp_path / "models" / name).read_text(), (committed / name).read_text(), what=f"stale {name}")
-
-
-def test_actuator_observers_reproduction_meets_every_target_and_is_committed(tmp_path):
-    """The core paper's experiment, rebuilt: every target met, and the committed report is current."""
-    assert main(["report", "actuator-observers", "--out", str(tmp_path)]) == 0
-    built = tmp_path / "actuator-observers"
+@pytest.mark.slow
+def test_actuator_observers_reproduction_meets_every_target(built_report):
+    """Liu et al. 2014's experiment, rebuilt: every target met, the faults identified, every figure shown."""
+    built = built_report("actuator-observers")
     results = json.loads((built / "results.json").read_text())
     assert results["targets"] and all(results["targets"].values()), results["targets"]
     assert results["thruster_fault_type"] == "bias" and abs(results["f_bar_a"] - 13.0) <= 0.01
@@ -95,29 +88,9 @@ def test_actuator_observers_reproduction_meets_every_target_and_is_committed(tmp
     for figure in ("fig4_without_ftc", "fig5_actuation_without_ftc", "fig6_estimates", "fig7_with_ftc",
                    "fig8_actuation_with_ftc"):
         assert (built / f"{figure}.svg").read_text().startswith("<?xml"), figure
-    committed = Path(__file__).resolve().parents[1] / "reports" / "actuator-observers"
-    for name in ("report.md", "report.html", *(p.name for p in committed.glob("*.svg"))):
-        assert_same_text((built / name).read_text(), (committed / name).read_text(), what=f"stale {name}")
-    # the C package the report links to: compiled cleanly by the build, equal to Python, committed as built
+        assert f"]({figure}.svg)" in (built / "report.md").read_text(), f"{figure} is shown in the report"
+    # the C package the report links to: compiled cleanly by the build, equal to Python
     assert results["c"]["compiled"] and results["c"]["max_relative_difference"] <= 1e-12
-    assert_same_folder(built / "c", committed / "c")
-    # results.json at the precision a reader uses (the last of its 9 digits may move with libm)
-    _assert_close(results, json.loads((committed / "results.json").read_text()), "results.json")
-
-
-def _assert_close(ours, theirs, where: str) -> None:
-    if isinstance(theirs, dict):
-        assert isinstance(ours, dict) and ours.keys() == theirs.keys(), f"{where}: keys differ"
-        for key in theirs:
-            _assert_close(ours[key], theirs[key], f"{where}.{key}")
-    elif isinstance(theirs, list):
-        assert isinstance(ours, list) and len(ours) == len(theirs), f"{where}: lengths differ"
-        for i, (a, b) in enumerate(zip(ours, theirs)):
-            _assert_close(a, b, f"{where}[{i}]")
-    elif isinstance(theirs, float) and not isinstance(theirs, bool):
-        assert ours == pytest.approx(theirs, rel=1e-7, abs=1e-12), f"stale {where}"
-    else:
-        assert ours == theirs, f"stale {where}"
 
 
 def test_simulate_lists_the_shipped_scenarios(capsys):

@@ -26,6 +26,7 @@ def test_report_html_needs_nothing_from_outside(page):
     markdown = (page.parent / "report.md").read_text()
     assert "<script" not in text and "<link" not in text
     assert not re.search(r'src="(?!data:)', text), "every image is embedded"
+    assert not re.search(r'href="[^"#:]+\.(svg|png)"', text), "figures are shown, not linked (the page works alone)"
     # every formula of the Markdown is MathML in the HTML, none left as TeX
     assert text.count('<math xmlns="http://www.w3.org/1998/Math/MathML" display="block">') == markdown.count("$$") // 2
     assert "$$" not in text and "\\begin{" not in text

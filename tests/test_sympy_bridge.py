@@ -60,8 +60,9 @@ def test_constants_keep_every_bit():
 def test_latex_uses_the_papers_symbols():
     nu, tau_d, K = ca.SX.sym("nu", 3), ca.SX.sym("tau_d", 3), ca.SX.sym("K", 3)
     text = latex(actuator_observer(vehicle("otter3dof"), "proportional").L(nu, tau_d, K))
-    assert r"\tau_{d,0}" in text and "k_{0}" in text and text.startswith(r"\begin{bmatrix}")
-    assert r"\nu_{2}" in latex(nu[2] ** 2)
+    # CasADi's elements are 0-based, the papers' (and the reports') 1-based
+    assert r"\tau_{d,1}" in text and "k_{1}" in text and "k_{0}" not in text and text.startswith(r"\begin{bmatrix}")
+    assert r"\nu_{3}" in latex(nu[2] ** 2)
 
 
 def test_mx_is_refused_with_a_clear_error():
@@ -74,4 +75,4 @@ def test_latex_can_hide_rounding_residues_but_only_when_asked():
     expression = ca.vertcat(1e-17 * k[0] - 1.0000000000000002 * k[1], 0.5 * k[0])
     assert "10^{-17}" in latex(expression, 4)
     shown = latex(expression, 4, zero_below=1e-12)
-    assert "10^{-17}" not in shown and "1.0" not in shown and "- k_{1}" in shown and "0.5 k_{0}" in shown
+    assert "10^{-17}" not in shown and "1.0" not in shown and "- k_{2}" in shown and "0.5 k_{1}" in shown

@@ -93,9 +93,10 @@ def to_sympy(expression) -> sp.Matrix | sp.Expr:
 
 
 def _symbol_latex(name: str) -> str:
-    """LaTeX of one symbol: ``nu_3`` -> ``\\nu_{3}``, ``tau_d_2`` -> ``\\tau_{d,2}``."""
+    """LaTeX of one symbol, indexed from 1 as in the papers: CasADi's element ``nu_3`` (0-based)
+    -> ``\\nu_{4}``, ``tau_d_2`` -> ``\\tau_{d,3}``."""
     match = re.fullmatch(r"(.*?)_(\d+)", name)
-    base, index = (match.group(1), match.group(2)) if match else (name, None)
+    base, index = (match.group(1), str(int(match.group(2)) + 1)) if match else (name, None)
     if base not in LATEX_NAMES:
         tex = r"\mathrm{" + base.replace("_", r"\_") + "}"
         return tex if index is None else f"{tex}_{{{index}}}"

@@ -154,12 +154,27 @@ violates its claim):
 
 {markdown_table(["channel", "decision", "time (s)", "f_bar", "variance"], decisions)}
 
-Figures: [Fig. 4](fig4_without_ftc.svg), [Fig. 5](fig5_actuation_without_ftc.svg),
-[Fig. 6](fig6_estimates.svg), [Fig. 7](fig7_with_ftc.svg), [Fig. 8](fig8_actuation_with_ftc.svg).
+### Figures (the paper's Figs. 4-8)
+
+![Fig. 4](fig4_without_ftc.svg)
+
+Fig. 4: the docking path with the faults and without correction.
+
+![Fig. 5](fig5_actuation_without_ftc.svg)
+
+Fig. 5: actuation without correction.
 
 ![Fig. 6](fig6_estimates.svg)
 
-![Fig. 4](fig4_without_ftc.svg) ![Fig. 7](fig7_with_ftc.svg)
+Fig. 6: the observers' fault estimates.
+
+![Fig. 7](fig7_with_ftc.svg)
+
+Fig. 7: the docking path with correction.
+
+![Fig. 8](fig8_actuation_with_ftc.svg)
+
+Fig. 8: actuation with correction.
 
 ## Error dynamics when tau_d varies
 

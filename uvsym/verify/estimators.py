@@ -17,7 +17,7 @@ For an output-injection observer of a plant ``x' = f(x, u, d, p), y = h(x, u, p)
 
 The branch-and-bound needs ``e' = 0`` exactly at ``e = 0`` in floating point, which
 ``f(x0) - f(x0 - e)`` is not (two roundings of f(x0)). Where the error dynamics are built from
-+, -, *, squares and constants only (a polynomial) of degree <= 2 in e, they are replaced by their
+``+``, ``-``, ``*``, squares and constants only (a polynomial) of degree <= 2 in e, they are replaced by their
 exact expansion ``e' = J e + 1/2 e^T H e`` (J, H at e = 0, in doubles), which is zero at e = 0 in
 any arithmetic; ``e'(0) = 0`` is proved first, and the certificate's method says so.
 """
