@@ -8,8 +8,6 @@ Python. Compare as ratios within one run: the machine is shared.
 
 from __future__ import annotations
 
-import json
-import platform
 import sys
 import tempfile
 import time
@@ -21,6 +19,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from c_timing import c_loop_ns  # noqa: E402
+from common import finish  # noqa: E402
 
 from uvsym.codegen import find_compiler
 from uvsym.derivation import observer_set
@@ -56,15 +55,10 @@ def main() -> dict:
     return {"function": combined.name(), "vehicle": "remus100", "form": "momentum",
             "sx_instructions": combined.n_instructions(), "step_ns": step_ns,
             "python_dm_args_us_per_call": best * 1e6, "speedup_c_over_python": best * 1e9 / step_ns,
-            "targets": {"step_ns_max": 300},
-            "machine": {"python": platform.python_version(), "casadi": ca.__version__,
-                        "processor": platform.machine()}}
+            }
 
 
 if __name__ == "__main__":
     if find_compiler() is None:
         sys.exit("no C compiler: nothing to measure")
-    results = main()
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
-    print(json.dumps(results, indent=2))
+    finish(main(), {"step_ns_max": 300}, RESULTS)

@@ -6,8 +6,6 @@ repeated batches within this one run; compare them as ratios (the machine is sha
 
 from __future__ import annotations
 
-import json
-import platform
 import sys
 import tempfile
 import time
@@ -18,11 +16,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from c_timing import c_loop_ns  # noqa: E402
+from common import finish  # noqa: E402
 from remus100_numpy import Remus100Numpy  # noqa: E402
 
 import uvsym  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "rhs.json"
+TARGETS = {"c_ns_per_call_max": 500, "speedup_vs_numpy_min": 150}
 ETA = np.array([10.0, -5.0, 20.0, 0.1, -0.05, 0.7])
 NU = np.array([1.5, 0.1, -0.05, 0.02, -0.03, 0.04])
 U = np.array([0.1, -0.05, 1200.0])
@@ -88,14 +88,9 @@ def main() -> dict:
         "casadi_buffer_us_per_call": buffer_s * 1e6,
         "c_ns_per_call": c_ns,
         "speedup_vs_numpy": None if c_ns is None else numpy_s * 1e9 / c_ns,
-        "targets": {"c_ns_per_call_max": 500, "speedup_vs_numpy_min": 150},
-        "machine": {"python": platform.python_version(), "casadi": ca.__version__, "numpy": np.__version__,
-                    "processor": platform.machine()},
     }
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
-    return results
+    return finish(results, TARGETS, RESULTS)
 
 
 if __name__ == "__main__":
-    print(json.dumps(main(), indent=2))
+    main()

@@ -13,23 +13,23 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import json  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import casadi as ca  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import docking_numpy  # noqa: E402
+from common import finish  # noqa: E402
 
 from uvsym.sim.scenario import load_scenario  # noqa: E402
 from uvsym.sim.simulation import observer_blocks, scenario_observers, simulate_scenario  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "sim.json"
+TARGETS = {"fast_sim_s_per_wall_s_min": 20000, "speedup_vs_numpy_min": 100,
+           "cvodes_vs_rk4_max_abs_state_difference_max": 1e-6}
 DURATION, STEP = 100.0, 0.01
 INTEGRATORS = ("cvodes", "idas", "rk", "collocation")
 
@@ -85,16 +85,8 @@ def main() -> dict:
         "fast_sim_s_per_wall_s": fast_rate,
         "speedup_vs_numpy": fast_rate * numpy_wall / DURATION,
         "cvodes_vs_rk4_max_abs_state_difference": float(np.max(np.abs(accurate["x"].values - fast["x"].values))),
-        "targets": {"fast_sim_s_per_wall_s_min": 20000, "speedup_vs_numpy_min": 100,
-                    "cvodes_vs_rk4_max_abs_state_difference_max": 1e-6},
-        "machine": {"python": platform.python_version(), "casadi": ca.__version__, "numpy": np.__version__,
-                    "processor": platform.machine(), "cpus": os.cpu_count()},
     }
 
 
 if __name__ == "__main__":
-    results = main()
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
-    print(json.dumps({k: results[k] for k in ("fast_sim_s_per_wall_s", "speedup_vs_numpy",
-                                              "cvodes_vs_rk4_max_abs_state_difference")}, indent=2))
+    finish(main(), TARGETS, RESULTS)
