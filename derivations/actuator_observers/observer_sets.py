@@ -1,30 +1,58 @@
 """The observer set ``actuator-observers`` (``uvsym codegen actuator-observers [--vehicle V] [--form F]``).
 
-The core paper's proportional, bias and constant observers on a vehicle, each as its continuous
+Liu et al. 2014's proportional, bias and constant observers on a vehicle, each as its continuous
 right-hand side ``<kind>_observer(x, eta, nu, tau_d, K) -> (x_dot, f_hat)`` and as a discrete step
 ``<kind>_step(x, eta, nu, tau_d, K, dt) -> (x_next, f_hat)`` (one RK4 step of dt seconds with eta,
 nu and tau_d held), plus ``actuator_observers_step``, all three at once.
+
+The package's example (``main.c``, and the float check of ``--float``) is the combined step on
+``EXAMPLE_STEPS`` samples of the vehicle's shipped scenario (the docking experiment for the
+docking AUV) from ``EXAMPLE_START``: measured pose and velocity, desired forces, the observers'
+states and the gains of the scenario's time constants. A vehicle without a shipped scenario
+gets no example.
 """
 
 from __future__ import annotations
 
-import casadi as ca
+import functools
+from dataclasses import replace
 
+import casadi as ca
+import numpy as np
+
+from derivations.actuator_observers.paper import DOCKING
+from derivations.papers import paper
+from uvsym.codegen.arguments import Entries, per_second
+from uvsym.codegen.example import Example
 from uvsym.codegen.observer_sets import ObserverSet
 from uvsym.codegen.package import Exported
+from uvsym.conventions import FORCE_LABELS
 from uvsym.models.registry import vehicle as library_vehicle
 from uvsym.observers.actuator import KINDS, actuator_observer
+from uvsym.sim.scenario import ObserverSpec, load_scenario, read_scenario_file, shipped_scenarios
+from uvsym.sim.simulation import scenario_observers, simulate_scenario
 from uvsym.symbolic import rk4
 
-__all__ = ["actuator_observers"]
+__all__ = ["EXAMPLE_START", "EXAMPLE_STEPS", "actuator_observers"]
+
+EXAMPLE_START = 10.0  # s into the scenario: the observers have converged on the faults present from t = 0
+EXAMPLE_STEPS = 500  # samples of the example (5 s of the docking experiment)
+PAPER = paper("liu2014")
 
 
-def _units(model, kind: str, form: str) -> tuple[str, str]:
-    """(unit of x and f_hat, unit of K) for an observer kind and form."""
-    force = ", ".join(model.force_units)
-    if kind == "proportional":
-        return "-", ("1/s per (desired force)^2, per channel" if form == "momentum" else "kg^2/(s (N or N m)^2)")
-    return force, ("1/s" if form == "momentum" else "kg^2/s, per channel (rate k/m^2)")
+def _gain_units(model, kind: str, form: str) -> tuple[str, ...]:
+    """Unit of each channel's K: the rate is k tau_d^2 / m^2 (proportional) or k / m^2, with m the
+    channel's mass or inertia (paper form), or k tau_d^2 and k (momentum form)."""
+    units = []
+    for force, velocity in zip(model.force_units, model.state_units[model.dof:]):
+        force = "*".join(force.split())
+        mass = "kg" if velocity == "m/s" else "(kg*m^2)"
+        scale = "" if form == "momentum" else f"{mass}^2"
+        if kind == "proportional":
+            units.append(f"{scale or '1'}/(s*{force}^2)" if "*" not in force else f"{scale or '1'}/(s*({force})^2)")
+        else:
+            units.append(f"{scale}/s" if scale else "1/s")
+    return tuple(units)
 
 
 def _step(function: ca.Function, name: str) -> ca.Function:
@@ -38,25 +66,72 @@ def _step(function: ca.Function, name: str) -> ca.Function:
                        ["x", "eta", "nu", "tau_d", "K", "dt"], ["x_next", "f_hat"], {"cse": True})
 
 
+def _scenario_name(vehicle: str) -> str | None:
+    """The shipped scenario that runs ``vehicle`` with observers: the docking experiment first."""
+    shipped = shipped_scenarios()
+    ordered = [DOCKING, *sorted(set(shipped) - {DOCKING})]
+    for name in ordered:
+        data = read_scenario_file(shipped[name])
+        if data.get("vehicle") == vehicle and data.get("observers"):
+            return name
+    return None
+
+
+@functools.lru_cache(maxsize=8)
+def _example(vehicle: str, form: str) -> Example | None:
+    """The combined step on the vehicle's shipped scenario (module docstring), or None without one."""
+    name = _scenario_name(vehicle)
+    if name is None:
+        return None
+    scenario = load_scenario(name)
+    given = {spec.kind: spec for spec in scenario.observers}
+    first, proportional = scenario.observers[0], given.get("proportional")
+    specs = tuple(replace(given[kind], form=form) if kind in given else
+                  ObserverSpec(kind, form, first.time_constant, proportional.tau_d if proportional else None)
+                  for kind in KINDS)
+    start = int(round(EXAMPLE_START / scenario.step))
+    duration = (start + EXAMPLE_STEPS) * scenario.step
+    run = simulate_scenario(replace(scenario, observers=specs, duration=duration), compiled=False)
+    rows = slice(start, start + EXAMPLE_STEPS)
+    n = scenario.model.dof
+    eta, nu = run["y"].values[rows, :n], run["y"].values[rows, n:]
+    tau_d = run["tau_desired"].values[rows]
+    states, gains = [], []
+    for kind, (observer, K) in scenario_observers(scenario.model, specs).items():
+        f_hat = run[f"f_hat/{kind}"].values[rows]
+        R = observer.R.map(EXAMPLE_STEPS)(nu.T, tau_d.T, K)  # x = f_hat + R(nu, tau_d, K)
+        states.append(f_hat + np.asarray(R).T)
+        gains.append(np.tile(K, (EXAMPLE_STEPS, 1)))
+    dt = np.full((EXAMPLE_STEPS, 1), scenario.step)
+    source = (f"the shipped scenario {name} ({scenario.model.name}), {EXAMPLE_STEPS} samples from "
+              f"t = {EXAMPLE_START:g} s, gains of its time constants")
+    return Example("actuator_observers_step", (np.hstack(states), eta, nu, tau_d, np.hstack(gains), dt), source)
+
+
 def actuator_observers(vehicle: str = "remus100", form: str = "momentum") -> ObserverSet:
     """The three actuator observers of a vehicle of the library, in the observer form given."""
     model = library_vehicle(vehicle)
-    pose = ", ".join(model.state_units[:model.dof])
-    velocity = ", ".join(model.state_units[model.dof:])
-    force = ", ".join(model.force_units)
+    n = model.dof
+    forces = FORCE_LABELS[n]
+    pose = Entries("eta, measured pose", model.state_labels[:n], model.state_units[:n])
+    velocity = Entries("nu, measured velocity", model.state_labels[n:], model.state_units[n:])
+    desired = Entries("tau_d, desired generalised force", forces, model.force_units)
     exported, steps = [], []
     for kind in KINDS:
         observer = actuator_observer(model, kind, form).function
-        f_unit, k_unit = _units(model, kind, form)
-        inputs = (f"observer state ({f_unit})", f"eta ({pose})", f"nu ({velocity})", f"tau_d ({force})",
-                  f"K ({k_unit})")
-        exported.append(Exported(observer, inputs, (f"x_dot ({f_unit}/s)", f"f_hat ({f_unit})"),
+        f_units = ("-",) * n if kind == "proportional" else model.force_units
+        state = Entries(f"observer state x = f_hat + R(nu) of the {kind} observer", forces, f_units)
+        estimate = Entries(f"f_hat, {kind} fault estimate", forces, f_units)
+        gain = Entries(f"K, gains of the {kind} observer", forces, _gain_units(model, kind, form))
+        inputs = (state, pose, velocity, desired, gain)
+        rate = Entries("x_dot, rate of the observer state", forces, tuple(per_second(u) for u in state.units))
+        exported.append(Exported(observer, inputs, (rate, estimate),
                                  f"{kind} observer of {model.name} ({form} form): continuous right-hand side"))
         step = _step(observer, f"{kind}_step")
         steps.append(step)
-        exported.append(Exported(step, (*inputs, "dt (s)"), (f"x_next ({f_unit})", f"f_hat ({f_unit})"),
+        following = Entries("x_next, observer state after dt", forces, state.units)
+        exported.append(Exported(step, (*inputs, Entries("dt, step", ("dt",), ("s",))), (following, estimate),
                                  f"{kind} observer of {model.name} ({form} form): one RK4 step of dt"))
-    n = model.dof
     x, eta, nu, tau_d, K, dt = (ca.SX.sym(v, size) for v, size in
                                 (("x", 3 * n), ("eta", n), ("nu", n), ("tau_d", n), ("K", 3 * n), ("dt", 1)))
     parts = [step(x[i * n:(i + 1) * n], eta, nu, tau_d, K[i * n:(i + 1) * n], dt) for i, step in enumerate(steps)]
@@ -64,10 +139,18 @@ def actuator_observers(vehicle: str = "remus100", form: str = "momentum") -> Obs
                            [ca.vertcat(*[p[0] for p in parts]), ca.vertcat(*[p[1] for p in parts])],
                            ["x", "eta", "nu", "tau_d", "K", "dt"], ["x_next", "f_hat"], {"cse": True})
     order = ", ".join(KINDS)
-    exported.append(Exported(combined, (f"states of the {order} observers, stacked", f"eta ({pose})",
-                                        f"nu ({velocity})", f"tau_d ({force})", f"K of the {order} observers, stacked",
-                                        "dt (s)"),
-                             (f"x_next, stacked ({order})", f"f_hat, stacked ({order})"),
+
+    def stacked(what: str, position: int, output: int | None = None) -> Entries:
+        """The three observers' arguments at ``position`` (an input, or an output), stacked in KINDS order."""
+        docs = [e.output_units[output] if output is not None else e.input_units[position] for e in exported[1::2]]
+        return Entries(f"{what} of the {order} observers, stacked",
+                       tuple(f"{kind}.{entry}" for kind, d in zip(KINDS, docs) for entry in d.names),
+                       tuple(unit for d in docs for unit in d.units))
+
+    exported.append(Exported(combined, (stacked("observer states", 0), pose, velocity, desired, stacked("gains K", 4),
+                                        Entries("dt, step", ("dt",), ("s",))),
+                             (stacked("x_next", 0, 0), stacked("f_hat", 0, 1)),
                              f"the {order} observers of {model.name} ({form} form): one RK4 step each"))
-    description = f"actuator-fault observers of the core paper (seeds/000) for {model.name}, {form} form"
-    return ObserverSet(f"uvsym_{vehicle}_observers", description, tuple(exported))
+    description = f"actuator-fault observers of {PAPER.short} for {model.name}, {form} form"
+    return ObserverSet(f"uvsym_{vehicle}_observers", description, tuple(exported), citation=PAPER.reference(),
+                       example=_example(vehicle, form))

@@ -9,10 +9,13 @@ option the factory does not take.
 from __future__ import annotations
 
 import inspect
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from uvsym.codegen.example import Example
 from uvsym.codegen.package import Exported, write_package
+from uvsym.codegen.precision import FLOAT_TOLERANCE, checked_float
 from uvsym.errors import CodegenError, UnknownNameError
 
 __all__ = ["ObserverSet", "make_observer_set", "option_flags", "options_of"]
@@ -20,19 +23,49 @@ __all__ = ["ObserverSet", "make_observer_set", "option_flags", "options_of"]
 
 @dataclass(frozen=True)
 class ObserverSet:
-    """A C package's worth of Functions: its C name, a one-line description, what it exports."""
+    """A C package's worth of Functions: its C name, a one-line description, what it exports.
+
+    citation: the reference of the method the set implements (written into the header, README
+    and manifest; empty when it implements no published method). example: experiment data for
+    one of its functions (:class:`~uvsym.codegen.example.Example`): ``main.c`` calls it, and a
+    float build is measured on it.
+    """
 
     package_name: str
     description: str
     exported: tuple[Exported, ...]
+    citation: str = ""
+    example: Example | None = None
 
     def __post_init__(self):
         if not self.exported or not all(isinstance(e, Exported) for e in self.exported):
             raise CodegenError(f"observer set {self.package_name}: exported must be a non-empty tuple of Exported")
+        if self.example is not None and not isinstance(self.example, Example):
+            raise CodegenError(f"observer set {self.package_name}: example must be an Example, "
+                               f"not {type(self.example).__name__}")
 
-    def write(self, out_dir, precision: str = "double") -> dict:
-        """Write the C package into ``out_dir`` (:func:`uvsym.codegen.package.write_package`); the manifest."""
-        return write_package(out_dir, list(self.exported), self.package_name, precision, self.description)
+    def write(self, out_dir, precision: str = "double", finite_check: bool = True,
+              float_tolerance: float = FLOAT_TOLERANCE) -> dict:
+        """Write the C package into ``out_dir`` (:func:`uvsym.codegen.package.write_package`); the manifest.
+
+        A float package is first run against double precision on the set's example
+        (:func:`uvsym.codegen.precision.checked_float`) and refused with PrecisionError beyond
+        ``float_tolerance``; its figure goes into the manifest (``float_check``). A set without an
+        example is written in float with a warning that it was not measured.
+        """
+        extra = {}
+        if precision == "float":
+            if self.example is None:
+                warnings.warn(f"observer set {self.package_name}: the float build is not measured against double "
+                              f"precision (the set gives no example data)", RuntimeWarning, stacklevel=2)
+            else:
+                exported = next((e for e in self.exported if e.function.name() == self.example.function), None)
+                if exported is None:
+                    raise CodegenError(f"observer set {self.package_name}: its example calls {self.example.function}, "
+                                       f"which it does not export")
+                extra["float_check"] = checked_float(exported, self.example, float_tolerance).to_dict(float_tolerance)
+        return write_package(out_dir, list(self.exported), self.package_name, precision, self.description,
+                             citation=self.citation, example=self.example, finite_check=finite_check, extra=extra)
 
 
 def options_of(factory: Callable[..., ObserverSet]) -> tuple[str, ...]:

@@ -6,17 +6,24 @@
                                                    <name>_casadi_<function>, so casadi.external
                                                    can load the library)
     include/<name>.h, src/<name>.c                 one documented wrapper per function:
-                                                   <name>_<function>(inputs..., outputs...)
-    main.c, harness.c                              an example program; a stdin/stdout harness
-    Makefile, CMakeLists.txt                       static and shared library, example, harness
-    manifest.json                                  functions, argument names, sizes, units,
-                                                   precision, SHA-256 of each serialised Function
+                                                   <name>_<function>(inputs..., outputs...),
+                                                   return codes <NAME>_OK, ... (ERROR_CODES)
+    main.c, harness.c                              an example call on experiment data; a
+                                                   stdin/stdout harness (uvsym.codegen.programs)
+    Makefile, CMakeLists.txt                       libraries, example, harness; CMake installs
+                                                   and exports a package config
+    README.md                                      API, sizes and units, build, threads, codes
+    manifest.json                                  functions, arguments with sizes and a unit
+                                                   per entry, precision, citation, SHA-256 of
+                                                   each serialised Function
 
 Every external C name starts with the package name (CasADi's internals with ``<name>_casadi__``,
-the real type is ``<name>_real``), so that packages of the same precision link into one program
-and their headers go into one source file. Work buffers are static (sized by CasADi's ``*_SZ_*``
-macros): nothing is allocated at run time, and the wrappers are not reentrant. The same
-functions and options give byte-identical files.
+the real type is ``<name>_real``, macros with ``<NAME>_``), so that packages of the same precision
+link into one program and their headers go into one source file. Work buffers are static (sized
+by CasADi's ``*_SZ_*`` macros): nothing is allocated at run time, and the wrappers are not
+reentrant. With ``finite_check`` (the default) a wrapper refuses a NaN or infinite input entry
+(``<NAME>_NONFINITE_INPUT``, outputs untouched) and reports a non-finite output entry
+(``<NAME>_NONFINITE_OUTPUT``). The same functions and options give byte-identical files.
 A double build matches the Python evaluation to 1e-12 relative; a float build (C only: it
 cannot be loaded through casadi.external) to 1e-5 of each call's largest output (tested).
 """
@@ -33,21 +40,37 @@ from pathlib import Path
 
 import casadi as ca
 
+from uvsym.codegen.arguments import Entries
+from uvsym.codegen.build_files import cmake_lists, makefile
+from uvsym.codegen.example import Example
+from uvsym.codegen.programs import example_program, harness_program
+from uvsym.codegen.readme import package_readme
 from uvsym.errors import CodegenError
 from uvsym.paths import output_folder
 
-__all__ = ["Exported", "PRECISIONS", "casadi_name", "write_package"]
+__all__ = ["ERROR_CODES", "Exported", "PRECISIONS", "casadi_name", "write_package"]
 
 PRECISIONS = ("double", "float")
+# return codes of every wrapper: suffix of the <NAME>_ macro, value, meaning
+ERROR_CODES = (("OK", 0, "success: every output written"),
+               ("EVAL_FAILED", 1, "CasADi's evaluation reported a failure"),
+               ("NONFINITE_INPUT", 2, "an input entry is NaN or infinite (finite check on): nothing computed, "
+                                      "outputs untouched"),
+               ("NONFINITE_OUTPUT", 3, "an output entry is NaN or infinite (finite check on): outputs written"))
 
 
 @dataclass(frozen=True)
 class Exported:
-    """A Function to export, with one unit string per input and output and a one-line description."""
+    """A Function to export, documented per input and output, with a one-line description.
+
+    input_units, output_units: one per argument, an :class:`~uvsym.codegen.arguments.Entries`
+    (what it is, each entry's name and unit: listed in the header and the manifest) or a plain
+    line of text (kept as given; the manifest then has no per-entry units).
+    """
 
     function: ca.Function
-    input_units: tuple[str, ...]
-    output_units: tuple[str, ...]
+    input_units: tuple[str | Entries, ...]
+    output_units: tuple[str | Entries, ...]
     description: str
 
     def __post_init__(self):
@@ -57,6 +80,17 @@ class Exported:
         for i in range(f.n_in()):
             if not f.sparsity_in(i).is_dense() or f.size2_in(i) != 1:
                 raise CodegenError(f"{f.name()}: input {f.name_in(i)} must be a dense column vector")
+        for docs, name, size in ((self.input_units, f.name_in, f.nnz_in), (self.output_units, f.name_out, f.nnz_out)):
+            for i, doc in enumerate(docs):
+                if isinstance(doc, Entries) and len(doc.units) != size(i):
+                    raise CodegenError(f"{f.name()}: argument {name(i)} has {size(i)} entries, its units "
+                                       f"{len(doc.units)}")
+
+    def arguments(self) -> list[tuple[str, str, int, str | Entries]]:
+        """("in" or "out", name, size, documentation) of every argument, inputs first."""
+        f = self.function
+        return ([("in", f.name_in(i), f.nnz_in(i), self.input_units[i]) for i in range(f.n_in())]
+                + [("out", f.name_out(i), f.nnz_out(i), self.output_units[i]) for i in range(f.n_out())])
 
 
 def _silence_unused(source: str) -> str:
@@ -88,159 +122,95 @@ def _renamed(function: ca.Function, name: str) -> ca.Function:
     return ca.Function(name, symbols, function.call(symbols), function.name_in(), function.name_out())
 
 
-def _wrapper(e: Exported, package: str) -> tuple[str, str]:
+def _doc_lines(direction: str, name: str, size: int, doc) -> list[str]:
+    """Header comment lines of one argument: what it is, then its entries with units in brackets."""
+    if not isinstance(doc, Entries):
+        return [f" * {direction:<3} {name}[{size}]: {doc}"]
+    lines = [f" * {direction:<3} {name}[{size}]: {doc.what}"]
+    lines += [f" *       [{i}] {entry} [{unit}]" for i, (entry, unit) in enumerate(zip(doc.names, doc.units))]
+    return lines
+
+
+def _wrapper(e: Exported, package: str, finite_check: bool) -> tuple[str, str]:
     """(prototype with its documentation, definition) of <package>_<function>."""
     f = e.function
-    name, real = casadi_name(package, f.name()), f"{package}_real"
+    name, real, codes = casadi_name(package, f.name()), f"{package}_real", package.upper()
     # an empty argument (no entries) is a pointer, which may be NULL: ISO C has no zero-size arrays
     args = [f"const {real} {f.name_in(i)}[{f.nnz_in(i)}]" if f.nnz_in(i) else f"const {real}* {f.name_in(i)}"
             for i in range(f.n_in())]
     args += [f"{real} {f.name_out(i)}[{f.nnz_out(i)}]" if f.nnz_out(i) else f"{real}* {f.name_out(i)}"
              for i in range(f.n_out())]
     doc = [f"/* {e.description}", " *"]
-    doc += [f" * in  {f.name_in(i)}[{f.nnz_in(i)}]: {e.input_units[i]}" for i in range(f.n_in())]
-    doc += [f" * out {f.name_out(i)}[{f.nnz_out(i)}]: {e.output_units[i]}" for i in range(f.n_out())]
-    doc += [" * Returns 0 on success. Uses static work buffers: not reentrant. */"]
+    doc += [line for argument in e.arguments() for line in _doc_lines(*argument)]
+    returns = (f"{codes}_OK, {codes}_EVAL_FAILED, {codes}_NONFINITE_INPUT or {codes}_NONFINITE_OUTPUT"
+               if finite_check else f"{codes}_OK or {codes}_EVAL_FAILED")
+    doc += [f" * Returns {returns}.", " * Uses static work buffers: not reentrant. */"]
     prototype = "\n".join(doc) + f"\nint {package}_{f.name()}({', '.join(args)});\n"
     inputs = ", ".join(f.name_in(i) for i in range(f.n_in()))
     outputs = ", ".join(f.name_out(i) for i in range(f.n_out()))
+    check_in = "".join(f"\n  if (!{package}_all_finite({f.name_in(i)}, {f.nnz_in(i)})) return {codes}_NONFINITE_INPUT;"
+                       for i in range(f.n_in()) if finite_check and f.nnz_in(i))
+    check_out = "".join(f"\n  if (!{package}_all_finite({f.name_out(i)}, {f.nnz_out(i)})) "
+                        f"return {codes}_NONFINITE_OUTPUT;" for i in range(f.n_out()) if finite_check and f.nnz_out(i))
     body = f"""int {package}_{f.name()}({', '.join(args)}) {{
   static casadi_int iw[{name}_SZ_IW > 0 ? {name}_SZ_IW : 1];
   static casadi_real w[{name}_SZ_W > 0 ? {name}_SZ_W : 1];
   const casadi_real* arg[{name}_SZ_ARG > 0 ? {name}_SZ_ARG : 1] = {{{inputs}}};
-  casadi_real* res[{name}_SZ_RES > 0 ? {name}_SZ_RES : 1] = {{{outputs}}};
-  return {name}(arg, res, iw, w, 0);
+  casadi_real* res[{name}_SZ_RES > 0 ? {name}_SZ_RES : 1] = {{{outputs}}};{check_in}
+  if ({name}(arg, res, iw, w, 0)) return {codes}_EVAL_FAILED;{check_out}
+  return {codes}_OK;
 }}
 """
     return prototype, body
 
 
-def _harness(functions: list[Exported], name: str) -> str:
-    """stdin/stdout harness: reads `index` then the inputs as text, prints the outputs (%.17g)."""
-    cases = []
-    for index, e in enumerate(functions):
-        f = e.function
-        reads = "\n".join(f"      for (i = 0; i < {f.nnz_in(k)}; ++i) if (scanf(\"%lf\", &v) != 1) return 1; "
-                          f"else in{k}[i] = ({name}_real)v;" for k in range(f.n_in()))
-        declare = " ".join(f"{name}_real in{k}[{max(1, f.nnz_in(k))}];" for k in range(f.n_in()))
-        declare += " " + " ".join(f"{name}_real out{k}[{max(1, f.nnz_out(k))}];" for k in range(f.n_out()))
-        call = ", ".join([f"in{k}" for k in range(f.n_in())] + [f"out{k}" for k in range(f.n_out())])
-        prints = "\n".join(f"      for (i = 0; i < {f.nnz_out(k)}; ++i) printf(\"%.17g \", (double)out{k}[i]);"
-                           for k in range(f.n_out()))
-        cases.append(f"""    case {index}: {{
-      {declare}
-{reads}
-      if ({name}_{f.name()}({call})) return 2;
-{prints}
-      break;
-    }}""")
-    return f"""/* Test harness: each record on stdin is a function index then its inputs, all as text;
-   prints that function's outputs on one line. Used to compare C with Python. */
-#include <stdio.h>
-#include "{name}.h"
-
-int main(void) {{
-  int index;
-  double v;
+_ALL_FINITE = """/* 1 when the n entries of v are all finite (not NaN, not infinite), else 0 */
+static int {package}_all_finite(const {package}_real* v, int n) {{
   int i;
-  while (scanf("%d", &index) == 1) {{
-    switch (index) {{
-{chr(10).join(cases)}
-    default:
-      return 3;
-    }}
-    printf("\\n");
-  }}
-  return 0;
+  for (i = 0; i < n; ++i) if (!isfinite(v[i])) return 0;
+  return 1;
 }}
 """
 
 
-def _example(functions: list[Exported], name: str) -> str:
-    f = functions[-1].function
-    declare = "\n".join(f"  {name}_real {f.name_in(i)}[{max(1, f.nnz_in(i))}] = {{0}};" for i in range(f.n_in()))
-    declare += "\n" + "\n".join(f"  {name}_real {f.name_out(i)}[{max(1, f.nnz_out(i))}];" for i in range(f.n_out()))
-    call = ", ".join([f.name_in(i) for i in range(f.n_in())] + [f.name_out(i) for i in range(f.n_out())])
-    last = f.name_out(f.n_out() - 1)
-    return f"""/* Example: one call of {name}_{f.name()} with zero inputs; prints its last output. */
-#include <stdio.h>
-#include "{name}.h"
-
-int main(void) {{
-  int i;
-{declare}
-  if ({name}_{f.name()}({call})) return 1;
-  for (i = 0; i < {f.nnz_out(f.n_out() - 1)}; ++i) printf("%g ", (double){last}[i]);
-  printf("\\n");
-  return 0;
-}}
-"""
+def _header(name: str, description: str, citation: str, precision: str, wrappers) -> str:
+    guard = name.upper() + "_H"
+    cited = f"\n   Implements: {citation}" if citation else ""
+    codes = "".join(f"#define {name.upper()}_{suffix} {value} /* {meaning} */\n"
+                    for suffix, value, meaning in ERROR_CODES)
+    return (f"/* {description or name}: wrapper API generated by uvsym. Precision: {precision}.{cited}\n"
+            f"   Units in brackets; README.md describes the API. */\n"
+            f"#ifndef {guard}\n#define {guard}\n#include \"{name}_casadi.h\"\n\ntypedef casadi_real {name}_real;\n\n"
+            f"/* return codes of every function below */\n{codes}\n"
+            + "\n".join(p for p, _ in wrappers) + f"\n#endif /* {guard} */\n")
 
 
-def _makefile(name: str) -> str:
-    return f"""# Builds lib{name}.a, lib{name}.so, the example and the harness.
-# CFLAGS may be overridden freely (e.g. make CFLAGS="-std=c99 -O2 -Wall -Wextra -Werror -fPIC");
-# include paths live in CPPFLAGS.
-CC ?= cc
-CFLAGS ?= -std=c99 -O2 -Wall -Wextra -fPIC
-CPPFLAGS += -Iinclude
-LDLIBS += -lm
-OBJ = src/{name}_casadi.o src/{name}.o
-
-all: lib{name}.a lib{name}.so example harness
-
-lib{name}.a: $(OBJ)
-\t$(AR) rcs $@ $(OBJ)
-
-lib{name}.so: $(OBJ)
-\t$(CC) $(CFLAGS) -shared -o $@ $(OBJ) $(LDLIBS)
-
-example: main.o lib{name}.a
-\t$(CC) $(CFLAGS) -o $@ main.o lib{name}.a $(LDLIBS)
-
-harness: harness.o lib{name}.a
-\t$(CC) $(CFLAGS) -o $@ harness.o lib{name}.a $(LDLIBS)
-
-%.o: %.c
-\t$(CC) $(CPPFLAGS) $(CFLAGS) -c -o $@ $<
-
-clean:
-\trm -f $(OBJ) main.o harness.o lib{name}.a lib{name}.so example harness
-
-.PHONY: all clean
-"""
-
-
-def _cmake(name: str) -> str:
-    return f"""cmake_minimum_required(VERSION 3.10)
-project({name} C)
-set(CMAKE_C_STANDARD 99)
-set(CMAKE_C_STANDARD_REQUIRED ON)
-set(CMAKE_POSITION_INDEPENDENT_CODE ON)
-set(SOURCES src/{name}_casadi.c src/{name}.c)
-add_library({name}_static STATIC ${{SOURCES}})
-add_library({name}_shared SHARED ${{SOURCES}})
-set_target_properties({name}_static {name}_shared PROPERTIES OUTPUT_NAME {name})
-foreach(target {name}_static {name}_shared)
-  target_include_directories(${{target}} PUBLIC include)
-  target_link_libraries(${{target}} PUBLIC m)
-endforeach()
-add_executable(example main.c)
-target_link_libraries(example {name}_static)
-add_executable(harness harness.c)
-target_link_libraries(harness {name}_static)
-"""
+def _argument_entry(name: str, size: int, doc) -> dict:
+    """An argument in the manifest: name, size, unit (its line of text), entries and units (lists, or None)."""
+    entries = doc if isinstance(doc, Entries) else None
+    return {"name": name, "size": size, "unit": str(doc), "entries": list(entries.names) if entries else None,
+            "units": list(entries.units) if entries else None}
 
 
 def write_package(out_dir, functions: list[Exported], name: str, precision: str = "double",
-                  description: str = "") -> dict:
-    """Write the package (module docstring) into ``out_dir``; returns the manifest."""
+                  description: str = "", *, citation: str = "", example: Example | None = None,
+                  finite_check: bool = True, extra: dict | None = None) -> dict:
+    """Write the package (module docstring) into ``out_dir``; returns the manifest.
+
+    citation: the reference of the method implemented (header, README, manifest); example: data
+    for ``main.c`` (:class:`~uvsym.codegen.example.Example`), else it calls on zeros;
+    finite_check: wrappers check inputs and outputs for NaN and infinity; extra: more manifest keys.
+    """
     if precision not in PRECISIONS:
         raise CodegenError(f"unknown precision {precision!r}; known: {', '.join(PRECISIONS)}")
     name = _c_name(name)
     names = [_c_name(e.function.name()) for e in functions]
     if len(set(names)) < len(names):
         raise CodegenError(f"package {name}: function names must differ; given {', '.join(names)}")
+    if example is not None:
+        if example.function not in names:
+            raise CodegenError(f"package {name}: the example calls {example.function}, not one of {', '.join(names)}")
+        example.check_against(functions[names.index(example.function)].function)
     out = output_folder(out_dir, "the package", CodegenError)
     (out / "include").mkdir(parents=True, exist_ok=True)
     (out / "src").mkdir(exist_ok=True)
@@ -255,28 +225,30 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
         header = (Path(scratch) / f"{name}_casadi.h").read_text()
     (out / "src" / f"{name}_casadi.c").write_text(source)
     (out / "include" / f"{name}_casadi.h").write_text(header)
-    wrappers = [_wrapper(e, name) for e in functions]
-    guard = name.upper() + "_H"
-    (out / "include" / f"{name}.h").write_text(
-        f"/* {description or name}: wrapper API generated by uvsym. Precision: {precision}. */\n"
-        f"#ifndef {guard}\n#define {guard}\n#include \"{name}_casadi.h\"\n\ntypedef casadi_real {name}_real;\n\n"
-        + "\n".join(p for p, _ in wrappers) + f"\n#endif /* {guard} */\n")
-    (out / "src" / f"{name}.c").write_text(f'#include "{name}.h"\n\n' + "\n".join(b for _, b in wrappers))
-    (out / "main.c").write_text(_example(functions, name))
-    (out / "harness.c").write_text(_harness(functions, name))
-    (out / "Makefile").write_text(_makefile(name))
-    (out / "CMakeLists.txt").write_text(_cmake(name))
+    wrappers = [_wrapper(e, name, finite_check) for e in functions]
+    (out / "include" / f"{name}.h").write_text(_header(name, description, citation, precision, wrappers))
+    helper = _ALL_FINITE.format(package=name) + "\n" if finite_check else ""
+    (out / "src" / f"{name}.c").write_text(f'#include <math.h>\n#include "{name}.h"\n\n{helper}'
+                                           + "\n".join(b for _, b in wrappers))
+    (out / "main.c").write_text(example_program(functions, name, example))
+    (out / "harness.c").write_text(harness_program(functions, name))
+    (out / "Makefile").write_text(makefile(name))
+    (out / "CMakeLists.txt").write_text(cmake_lists(name))
     manifest = {
-        "package": name, "description": description, "precision": precision, "casadi": ca.__version__,
+        "package": name, "description": description, "citation": citation, "precision": precision,
+        "casadi": ca.__version__, "finite_check": finite_check,
+        "return_codes": {f"{name.upper()}_{suffix}": {"value": value, "meaning": meaning}
+                         for suffix, value, meaning in ERROR_CODES
+                         if finite_check or "NONFINITE" not in suffix},
+        "example": None if example is None else {"function": f"{name}_{example.function}", "source": example.source},
         "functions": [{
             "name": e.function.name(), "c_function": f"{name}_{e.function.name()}",
             "casadi_function": casadi_name(name, e.function.name()), "description": e.description,
-            "inputs": [{"name": e.function.name_in(i), "size": e.function.nnz_in(i), "unit": e.input_units[i]}
-                       for i in range(e.function.n_in())],
-            "outputs": [{"name": e.function.name_out(i), "size": e.function.nnz_out(i), "unit": e.output_units[i]}
-                        for i in range(e.function.n_out())],
+            "inputs": [_argument_entry(n, size, doc) for d, n, size, doc in e.arguments() if d == "in"],
+            "outputs": [_argument_entry(n, size, doc) for d, n, size, doc in e.arguments() if d == "out"],
             "sha256": hashlib.sha256(e.function.serialize().encode()).hexdigest(),
         } for e in functions],
-    }
+    } | (extra or {})
+    (out / "README.md").write_text(package_readme(manifest))
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n")
     return manifest
