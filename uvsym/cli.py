@@ -217,11 +217,15 @@ def _cmd_codegen(args) -> int:
     options |= _set_options(args.name, factory, args.set_options)
     observers = observer_set(args.name, **options)
     claim_folder(args.out, "the C package", "package", args.force)
-    manifest = observers.write(args.out, "float" if args.float else "double")
+    manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check)
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "
           f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
           f"build with 'make' or cmake")
+    if "float_check" in manifest:
+        check = manifest["float_check"]
+        print(f"float against double on {check['source']}: largest relative difference "
+              f"{check['max_relative_difference']:.2g} (limit {check['tolerance']:g})")
     return 0
 
 
@@ -321,7 +325,10 @@ def _parser() -> argparse.ArgumentParser:
     codegen.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
     codegen.add_argument("--vehicle", help="vehicle of the library, for a set that takes one (default: the set's)")
     codegen.add_argument("--form", help="observer form, for a set that takes one (default: the set's)")
-    codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi)")
+    codegen.add_argument("--float", action="store_true", help="single precision (C only: not loadable by casadi); "
+                                                              "refused when it strays from double on the set's example")
+    codegen.add_argument("--no-finite-check", action="store_true",
+                         help="wrappers without the NaN/infinity check of inputs and outputs (codes 2 and 3)")
     codegen.set_defaults(run=_cmd_codegen)
     verify = sub.add_parser("verify", help="check the derivations' claims by machine; exit 1 if any is unexpected")
     verify.add_argument("names", nargs="*", help="derivations (default: all that make claims)")
