@@ -35,15 +35,23 @@ def committed_reports(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def built_report(tmp_path_factory):
-    """``built_report(name)``: the folder ``uvsym report name`` writes, built once per session."""
-    from uvsym.cli import main
+    """``built_report(name)``: the folder ``uvsym report name`` writes, built once per session; the
+    working tree's reports/NAME when ``uvsym report`` built it from exactly this code (its build
+    stamp's source fingerprint is the current one, as after the README's first command)."""
+    from uvsym.cli import BUILD_STAMP, main
+    from uvsym.derivation import derivation, source_fingerprint
 
     root, built = tmp_path_factory.mktemp("built"), {}
 
     def build(name: str) -> Path:
         if name not in built:
-            assert main(["report", name, "--out", str(root)]) == 0, f"uvsym report {name} failed"
-            built[name] = root / name
+            stamp = ROOT / "reports" / name / BUILD_STAMP
+            if stamp.exists() and json.loads(stamp.read_text()).get("source_fingerprint") == \
+                    source_fingerprint(derivation(name)):
+                built[name] = stamp.parent
+            else:
+                assert main(["report", name, "--out", str(root)]) == 0, f"uvsym report {name} failed"
+                built[name] = root / name
         return built[name]
 
     return build

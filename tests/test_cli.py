@@ -65,9 +65,13 @@ def test_report_models_is_deterministic(tmp_path, built_report):
     first = built_report("models")
     assert main(["report", "models", "--out", str(tmp_path)]) == 0
     names = sorted(p.name for p in first.iterdir())
-    assert names == ["report.html", "report.md", "results.json", "step_responses.svg"]
+    assert names == [".build.json", "report.html", "report.md", "results.json", "step_responses.svg"]
     for name in names:
         assert (first / name).read_bytes() == (tmp_path / "models" / name).read_bytes(), name
+    from uvsym.derivation import derivation, source_fingerprint
+
+    stamp = json.loads((tmp_path / "models" / ".build.json").read_text())
+    assert stamp == {"derivation": "models", "source_fingerprint": source_fingerprint(derivation("models"))}
 
 
 def test_models_report_checks_the_reference_cases(built_report):
@@ -238,3 +242,21 @@ def test_a_study_scenario_runs_through_its_derivation_and_bad_study_fields_are_n
     assert "study: unknown derivation 'nosuch'" in capsys.readouterr().err
     with pytest.raises(DerivationError, match="ships scenarios but has no simulate"):
         Derivation("x", "X", lambda out_dir, progress: None, scenarios={"a": shipped})
+
+
+def test_the_source_fingerprint_moves_with_any_source_file_of_the_study(tmp_path, monkeypatch):
+    import importlib
+
+    from uvsym.derivation import Derivation, source_fingerprint
+
+    package = tmp_path / "scratch_study"
+    package.mkdir()
+    (package / "__init__.py").write_text("def build(out_dir, progress):\n    pass\n")
+    (package / "data.json").write_text('{"gain": 1.0}\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    module = importlib.import_module("scratch_study")
+    study = Derivation("scratch", "Scratch", module.build)
+    before = source_fingerprint(study)
+    assert source_fingerprint(study) == before
+    (package / "data.json").write_text('{"gain": 2.0}\n')
+    assert source_fingerprint(study) != before

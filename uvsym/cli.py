@@ -14,13 +14,22 @@ from pathlib import Path
 import numpy as np
 
 from uvsym import __version__
-from uvsym.derivation import Derivation, derivation, load_derivations, observer_set, observer_sets
+from uvsym.derivation import (
+    Derivation,
+    derivation,
+    load_derivations,
+    observer_set,
+    observer_sets,
+    source_fingerprint,
+)
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
 from uvsym.paths import claim_folder, output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
-__all__ = ["main"]
+__all__ = ["BUILD_STAMP", "main"]
+
+BUILD_STAMP = ".build.json"  # in each report folder: the source fingerprint it was built from (not committed)
 
 
 def _table(rows: list[list[str]], header: list[str]) -> str:
@@ -121,6 +130,8 @@ def _cmd_report(args) -> int:
         study.build(out_dir, progress)
         progress("report.html")
         write_html(out_dir)
+        (out_dir / BUILD_STAMP).write_text(json.dumps({"derivation": study.name,
+                                                       "source_fingerprint": source_fingerprint(study)}) + "\n")
         print(f"wrote {out_dir}")
     return 0
 
@@ -258,6 +269,7 @@ def _cmd_verify(args) -> int:
     import time
 
     from uvsym.report.markdown import write_json
+    from uvsym.verify.certificate import STATUSES
 
     everything, failures = [], 0
     for study in (s for s in _selected(args.names) if s.claims is not None):
@@ -278,7 +290,11 @@ def _cmd_verify(args) -> int:
                           for r in rows], ["claim", "set", "method", "status", "expected", "margin", "s"]) + "\n")
     if args.json:
         print(json.dumps(everything, indent=2))
-    elif failures:
+    else:
+        counts = {status: sum(row["status"] == status for row in everything) for status in STATUSES}
+        print(f"{counts['proved']} proved (rigorous), {counts['checked']} checked (numerical evidence, not proofs), "
+              f"{counts['refuted']} refuted, {counts['inconclusive']} inconclusive")
+    if failures and not args.json:
         print(f"{failures} claim(s) differ from their expected status", file=sys.stderr)
     return 1 if failures else 0
 

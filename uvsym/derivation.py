@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from uvsym.verify.certificate import Certificate
 
 __all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivations", "observer_set",
-           "observer_sets", "study_scenarios"]
+           "observer_sets", "source_fingerprint", "study_scenarios"]
 
 GROUP = "uvsym.derivations"
 
@@ -148,3 +148,31 @@ def study_scenarios() -> dict[str, tuple[str, Path]]:
                 raise DerivationError(f"scenario {name!r} is shipped by both {found[name][0]!r} and {study.name!r}")
             found[name] = (study.name, path)
     return dict(sorted(found.items()))
+
+
+_SOURCE_SUFFIXES = (".py", ".toml", ".json", ".txt", ".csv")
+
+
+def source_fingerprint(study: Derivation) -> str:
+    """SHA-256 of everything a report depends on: the sources and data of uvsym and of the study's
+    top-level package, and the versions of the libraries that compute it. Two builds with the same
+    fingerprint come from the same code (``uvsym report`` records it in ``NAME/.build.json``)."""
+    import hashlib
+    import importlib
+    import importlib.metadata
+    import sys
+
+    import uvsym
+
+    digest = hashlib.sha256(sys.version.encode())
+    for library in ("casadi", "numpy", "scipy", "sympy", "matplotlib", "cvxpy", "clarabel"):
+        try:
+            digest.update(f"{library} {importlib.metadata.version(library)}".encode())
+        except importlib.metadata.PackageNotFoundError:
+            digest.update(f"{library} none".encode())
+    top = importlib.import_module(study.build.__module__.split(".")[0])
+    for root in sorted({Path(uvsym.__file__).parent, Path(top.__file__).parent}):
+        for path in sorted(root.rglob("*")):
+            if path.suffix in _SOURCE_SUFFIXES and "__pycache__" not in path.parts and path.is_file():
+                digest.update(str(path.relative_to(root.parent)).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
