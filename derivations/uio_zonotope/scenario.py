@@ -20,6 +20,7 @@ The result holds the true states ``x``, measurements ``y``, commanded voltages `
 from __future__ import annotations
 
 import numbers
+import time
 
 import numpy as np
 
@@ -69,6 +70,7 @@ def simulate(table: dict, *, name: str = "scenario", progress=None, method=None)
     if progress is not None:
         progress(f"{name}: {samples} samples, seed {seed}")
     d = design()
+    started = time.perf_counter()
     runs = simulate_runs(seed, 1, fault, samples)
     outside = detection(runs, 0)["outside"][:, :, 0]
     x, u = d.plant.x, d.plant.u
@@ -83,5 +85,6 @@ def simulate(table: dict, *, name: str = "scenario", progress=None, method=None)
         signals[f"alarm/{obs.name}"] = Signal(outside[:, i:i + 1].astype(float), ("alarm",), ("-",))
     meta = {"study": "uio-zonotope", "scenario": name, "samples": samples, "seed": seed, "dt_s": DT,
             "fault": None if fault is None else {"actuator": u.names[fault.actuator], "kind": fault.kind,
-                                                 "size": fault.size, "onset_sample": fault.onset}}
+                                                 "size": fault.size, "onset_sample": fault.onset},
+            "wall_s": time.perf_counter() - started}
     return SimResult(np.arange(samples) * DT, signals, meta)

@@ -24,6 +24,7 @@ With bounded measurement noise, ``y = C x + v``, the discrete error obeys
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import casadi as ca
@@ -152,9 +153,15 @@ def uio_matrices(A, B, C, D, *, poles=None, K1=None, time: str = "discrete") -> 
         if poles.size != n or not np.all(np.isfinite(poles)):
             raise ObserverError(f"UIO: poles must be {n} finite eigenvalues, got {poles.size}")
         try:
-            K1 = place_poles(A1.T, C.T, poles).gain_matrix.T
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # a non-converged placement is caught below by its eigenvalues
+                K1 = place_poles(A1.T, C.T, poles).gain_matrix.T
         except (ValueError, np.linalg.LinAlgError) as exc:
             raise ObserverError(f"UIO: poles cannot be placed: {exc}") from None
+        placed = np.sort_complex(np.linalg.eigvals(A1 - K1 @ C))
+        if not np.allclose(placed, np.sort_complex(poles), atol=1e-6):
+            raise ObserverError(f"UIO: poles cannot be placed (placement needs (C, T A) observable, not only "
+                                f"detectable); got eigenvalues {np.round(placed, 6).tolist()}: give K1 instead")
     K1 = _matrix(K1, "K1", rows=n, cols=C.shape[0])
     F = A1 - K1 @ C
     eigenvalues = np.linalg.eigvals(F)

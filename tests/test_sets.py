@@ -1,0 +1,136 @@
+"""Zonotopes: operations against vertex enumeration, reduction encloses (property tests), propagation
+against closed forms, bad inputs."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uvsym.errors import SetDivergenceError, SetError
+from uvsym.sets import METHODS, Zonotope, box, carry_coefficients, propagate, reduce
+
+
+def _vertices(Z: Zonotope) -> np.ndarray:
+    """Every c + G xi with xi in {-1, 1}^m (small m): the oracle."""
+    signs = np.array(list(itertools.product((-1.0, 1.0), repeat=Z.order)))
+    return Z.center + signs @ Z.generators.T
+
+
+def _random_zonotope(seed: int, n: int, m: int) -> Zonotope:
+    rng = np.random.default_rng(seed)
+    return Zonotope(rng.normal(size=n), rng.normal(size=(n, m)) * rng.uniform(0.01, 2.0, m))
+
+
+def test_map_sum_hull_and_support_match_vertex_enumeration():
+    Z1, Z2 = _random_zonotope(1, 3, 5), _random_zonotope(2, 3, 4)
+    M, b = np.random.default_rng(3).normal(size=(2, 3)), np.array([0.5, -1.0])
+    mapped = Z1.map(M, b)
+    np.testing.assert_allclose(np.sort(_vertices(mapped), axis=0), np.sort(_vertices(Z1) @ M.T + b, axis=0),
+                               atol=1e-12)
+    total = Z1 + Z2
+    sums = (_vertices(Z1)[:, None, :] + _vertices(Z2)[None, :, :]).reshape(-1, 3)
+    for a in np.random.default_rng(4).normal(size=(10, 3)):
+        assert total.support(a) == pytest.approx(np.max(sums @ a), rel=1e-12)
+    lower, upper = total.interval_hull()
+    np.testing.assert_allclose(lower, sums.min(axis=0), atol=1e-12)
+    np.testing.assert_allclose(upper, sums.max(axis=0), atol=1e-12)
+
+
+def test_containment_inside_and_just_outside():
+    Z = _random_zonotope(5, 3, 7)
+    rng = np.random.default_rng(6)
+    for xi in rng.uniform(-1, 1, (20, 7)):
+        assert Z.contains(Z.center + Z.generators @ xi)
+    for a in rng.normal(size=(10, 3)):
+        a /= np.linalg.norm(a)
+        beyond = Z.center + (Z.support(a) - a @ Z.center + 1e-6) * a  # a^T x exceeds the support
+        assert not Z.contains(beyond)
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(1, 5), extra=st.integers(0, 30), seed=st.integers(0, 10_000), method=st.sampled_from(METHODS),
+       data=st.data())
+def test_reduction_always_encloses(n, extra, seed, method, data):
+    Z = _random_zonotope(seed, n, n + extra)
+    target = data.draw(st.integers(n, n + extra))
+    reduced = reduce(Z, target, method)
+    Zr, R = reduced.zonotope, reduced.coefficients
+    assert Zr.order <= target
+    np.testing.assert_allclose(Zr.center, Z.center)
+    np.testing.assert_allclose(Zr.generators @ R, Z.generators, atol=1e-12)
+    assert np.all(np.sum(np.abs(R), axis=1) <= 1 + 1e-12)
+    rng = np.random.default_rng(seed)
+    for a in rng.normal(size=(20, n)):  # support functions of the two sets (closed form, independent of R)
+        assert Zr.support(a) >= Z.support(a) - 1e-9 * (1 + abs(Z.support(a)))
+    for xi in rng.choice([-1.0, 1.0], size=(3, Z.order)):  # vertices of the original, by LP
+        assert Zr.contains(Z.center + Z.generators @ xi, tolerance=1e-7)
+
+
+def test_reduction_bad_orders_and_methods():
+    Z = _random_zonotope(0, 4, 10)
+    with pytest.raises(SetError, match="dimension 4"):
+        reduce(Z, 3)
+    with pytest.raises(SetError, match="generators must be an integer"):
+        reduce(Z, 5.5)
+    with pytest.raises(SetError, match="unknown reduction method"):
+        reduce(Z, 6, "wobble")
+    assert reduce(Z, 12).zonotope.order == 10  # nothing to do
+
+
+def test_bad_inputs_are_typed_errors_naming_the_argument():
+    with pytest.raises(SetError, match="center"):
+        Zonotope([0.0, np.nan], np.eye(2))
+    with pytest.raises(SetError, match="rows"):
+        Zonotope([0.0, 0.0], np.eye(3))
+    with pytest.raises(SetError, match="map matrix"):
+        Zonotope([0.0, 0.0], np.eye(2)).map(np.eye(3))
+    with pytest.raises(SetError, match="Minkowski"):
+        Zonotope([0.0], [[1.0]]) + Zonotope([0.0, 0.0], np.eye(2))
+    with pytest.raises(SetError, match="upper bound"):
+        box([0.0, 0.0], [1.0, np.inf])
+    with pytest.raises(SetError, match="lower bound exceeds"):
+        box([1.0], [0.0])
+
+
+def test_scalar_propagation_matches_the_geometric_series():
+    """x+ = a x + w, |w| <= 1, |x0| <= 1: the hull radius is a^k + (1 - a^k) / (1 - a), exactly."""
+    a = 0.5
+    result = propagate([[a]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 30, generators=3)
+    k = np.arange(30)
+    np.testing.assert_allclose(result.upper[:, 0], a ** k + (1 - a ** k) / (1 - a), rtol=1e-12)
+    np.testing.assert_allclose(result.exact_radius[:, 0], result.upper[:, 0], rtol=1e-12)
+    assert max(z.order for z in result.outputs) <= 3
+
+
+def test_carried_coefficients_reproduce_simulated_outputs():
+    rng = np.random.default_rng(7)
+    A = np.array([[0.6, 0.3, 0.0], [-0.2, 0.5, 0.1], [0.0, 0.2, 0.4]])
+    C = rng.normal(size=(2, 3))
+    X0, W = box(-0.1 * np.ones(3), 0.1 * np.ones(3)), Zonotope(np.zeros(3), rng.normal(size=(3, 2)) * 0.05)
+    result = propagate(A, C, X0, W, 40, generators=6, method="pca")
+    runs = 5
+    a0, eta = rng.uniform(-1, 1, (3, runs)), rng.uniform(-1, 1, (40, 2, runs))
+    coefficients = carry_coefficients(result, a0, eta)
+    x = X0.generators @ a0
+    for k in range(40):
+        if k:
+            x = A @ x + W.generators @ eta[k]
+        Z = result.outputs[k]
+        a = coefficients[k, :Z.order]
+        np.testing.assert_allclose(Z.center[:, None] + Z.generators @ a, C @ x, atol=1e-12)
+        assert np.all(np.abs(a) <= 1 + 1e-12)
+        lower, upper = result.lower[k], result.upper[k]
+        assert np.all((C @ x >= lower[:, None] - 1e-12) & (C @ x <= upper[:, None] + 1e-12))
+
+
+def test_growing_enclosure_is_an_error_not_a_long_run():
+    with pytest.raises(SetDivergenceError, match="modulus >= 1"):
+        propagate([[1.0, 0.01], [0.0, 1.0]], np.eye(2), box([-1, -1], [1, 1]), box([-1, -1], [1, 1]), 10, 4)
+    with pytest.raises(SetDivergenceError, match="reduction wraps"):  # a limit below the exact set itself
+        propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 5, 2, growth_limit=0.5)
+    with pytest.raises(SetError, match="dimension 2"):
+        propagate(np.eye(2) * 0.5, np.eye(2), box([-1.0], [1.0]), box([-1, -1], [1, 1]), 5, 4)
