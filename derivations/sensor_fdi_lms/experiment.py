@@ -42,7 +42,8 @@ class Run:
     """One run: fault on ``sensor`` (an output of the plant) of ``size_deg`` (deg; deg/s for
     kind drift), ``profile`` (step, pulse: ``length`` samples, ramp over ``length`` samples,
     incipient with time constant ``length`` samples, intermittent of period ``2 length``) from
-    recorded sample ``onset``; None size: no fault. ftc: substitute the sensor once confirmed."""
+    recorded sample ``onset``; None size: no fault. ftc: substitute the sensor once the fault is
+    confirmed (``substitute_on="fault"``) or from the first eps^2 alarm (``"alarm"``, Sec. 4.3)."""
 
     size_deg: float | None = 30.0
     onset: int = FAULT_SAMPLE
@@ -51,6 +52,7 @@ class Run:
     profile: str = "step"
     length: int = 1
     ftc: bool = True
+    substitute_on: str = "fault"
     seed: int = 0
     warm_up: int = WARM_UP
     record: int = RECORD
@@ -101,7 +103,7 @@ def run(spec: Run) -> Outcome:
     if spec.size_deg is not None:
         faults.append(SensorFault(plant.y.index(spec.sensor), spec.kind, math.radians(spec.size_deg),
                                   spec.profile_object()))
-    supervisor = SubstitutionSupervisor(d.monitor, correct=spec.ftc)
+    supervisor = SubstitutionSupervisor(d.monitor, correct=spec.ftc, substitute_on=spec.substitute_on)
     result = simulate_system(plant, d.blocks, duration=samples * DT, dt=DT, x0=[math.radians(SET_POINT_DEG), 0.0],
                              sensor_faults=tuple(faults), substitutions={"psi": "psi_sub"}, supervisor=supervisor,
                              d=torque_table(samples, spec.seed), seed=spec.seed, substeps=4)

@@ -74,11 +74,18 @@ class SubstitutionSupervisor:
     Every sample it reads the monitor's published flags ``frozen_<y>``, ``fault_<y>`` and
     ``disturbance_<y>`` (y its measured channel) and, once the fault is confirmed, returns
     ``Substitution({y})``: from the next sample on the loop reads the monitor's substitute
-    ``<y>_sub`` instead of the sensor (wire ``substitutions={y: f"{y}_sub"}``). ``correct=False``
-    logs without substituting (the run without fault-tolerant control). ``events``: the log.
+    ``<y>_sub`` instead of the sensor (wire ``substitutions={y: f"{y}_sub"}``). With
+    ``substitute_on="alarm"`` (the paper's Sec. 4.3) it substitutes from the first ``eps^2``
+    alarm and switches back when the freeze is released unconfirmed. ``correct=False`` logs
+    without substituting (the run without fault-tolerant control). ``events``: the log.
     """
 
-    def __init__(self, monitor, *, correct: bool = True):
+    MODES = ("fault", "alarm")
+
+    def __init__(self, monitor, *, correct: bool = True, substitute_on: str = "fault"):
+        if substitute_on not in self.MODES:
+            raise ObserverError(f"supervisor: substitute_on must be one of {', '.join(self.MODES)}, got "
+                                f"{substitute_on!r}")
         channel = monitor.reads_y.names[0]
         names = monitor.publishes.names
         try:
@@ -87,6 +94,7 @@ class SubstitutionSupervisor:
             raise ObserverError(f"supervisor: {monitor.name} does not publish frozen_{channel}, fault_{channel} and "
                                 f"disturbance_{channel}; it publishes {', '.join(names)}") from None
         self.monitor, self.channel, self.period, self.correct = monitor.name, channel, monitor.dt, correct
+        self.substitute_on = substitute_on
         self.events: list[Event] = []
         self._samples, self._frozen, self._fault, self._switched = 0, 0.0, 0.0, False
 
@@ -105,11 +113,14 @@ class SubstitutionSupervisor:
                 self.events.append(Event(float(ti), k, "no R alarm in time: disturbance, filter released"))
             self._frozen, self._fault = frozen[i], fault[i]
         self._samples += len(t)
-        if self.correct and not self._switched and self._fault > 0.5:
-            self._switched = True
-            return Substitution({self.channel})
-        return None
+        wanted = self._fault > 0.5 or (self.substitute_on == "alarm" and self._frozen > 0.5)
+        if not self.correct or wanted == self._switched:
+            return None
+        self._switched = wanted
+        self.events.append(Event(float(t[-1]), self._samples - 1, f"substitution {'on' if wanted else 'off'} "
+                                 "from the next sample"))
+        return Substitution({self.channel} if wanted else frozenset())
 
     def first(self, what: str) -> Event | None:
-        """The first logged event whose text starts with ``what`` ("eps2", "R", "no R"), or None."""
+        """The first logged event whose text starts with ``what`` ("eps2", "R", "no R", "substitution on"), or None."""
         return next((e for e in self.events if e.what.startswith(what)), None)

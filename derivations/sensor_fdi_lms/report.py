@@ -1,0 +1,124 @@
+"""``report.md``, ``results.json`` and figures of the LMS-FIR sensor-fault study."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from derivations.papers import paper
+from derivations.sensor_fdi_lms import design as D
+from derivations.sensor_fdi_lms.claims import NEGATIVE_FACTOR, healthy_input, lms_claims
+from derivations.sensor_fdi_lms.experiment import Run, first_sample, run
+from derivations.sensor_fdi_lms.figures import criteria_figure, delay_figure, heading_figure, roc_figure
+from derivations.sensor_fdi_lms.observer_sets import lms_set
+from derivations.sensor_fdi_lms.study import R0_GRID, SIZE_DEG, WITHIN, detection_study
+from derivations.sensor_fdi_lms.text import report_text
+from uvsym.observers.lms import mu_bound
+from uvsym.report import write_json
+from uvsym.report.sections import c_package, claim_rows
+
+__all__ = ["build", "PAPER", "SETTLED", "FTC_WINDOW"]
+
+PAPER = {"eps2_first_alarm_sample": 70, "R_first_alarm_sample": 75,
+         "heading_without_ftc_deg": {"30": 120.0, "20": 130.0, "10": 140.0}, "max_abs_heading_error_with_ftc_deg": 3.0,
+         "spike_classified_as": "disturbance"}
+SETTLED = 100  # samples (20 s) at the end of the record whose mean heading is the settled heading
+FTC_WINDOW = 300  # samples (60 s) after the onset over which the FTC error is taken
+
+
+def _summary(outcome) -> dict:
+    """Alarm samples, settled heading and the largest heading error over FTC_WINDOW after the onset."""
+    k, heading = outcome.k, outcome.heading_deg()
+    after = (k >= D.FAULT_SAMPLE) & (k < D.FAULT_SAMPLE + FTC_WINDOW)
+    confirmed = outcome.supervisor.first("R alarm")
+    switched = outcome.supervisor.first("substitution on")
+    return {"eps2_first_alarm_sample": first_sample(outcome.monitor("alarm_eps2_psi"), k),
+            "R_first_alarm_sample": first_sample(outcome.monitor("alarm_R_psi"), k, D.FAULT_SAMPLE),
+            "confirmed_sample": None if confirmed is None else confirmed.sample - outcome.spec.warm_up,
+            "substituted_from_sample": None if switched is None else switched.sample + 1 - outcome.spec.warm_up,
+            "settled_heading_deg": float(np.mean(heading[-SETTLED:])),
+            "max_abs_heading_error_deg": float(np.max(np.abs(heading[after] - D.SET_POINT_DEG))),
+            "events": [[e.sample - outcome.spec.warm_up, e.what] for e in outcome.supervisor.events
+                       if e.sample >= outcome.spec.warm_up]}
+
+
+def _runs(progress) -> tuple[dict, dict]:
+    """Every run of the reproduction: the three faults with and without FTC (both substitution
+    rules), the one-sample disturbance; (outcomes for the figures, summaries)."""
+    outcomes, summaries = {}, {}
+    for size in D.FAULT_SIZES_DEG:
+        for label, spec in (("ftc", Run(size_deg=size)), ("no_ftc", Run(size_deg=size, ftc=False)),
+                            ("ftc_on_alarm", Run(size_deg=size, substitute_on="alarm"))):
+            progress(f"run: +{size:g} deg compass fault, {label}")
+            outcomes[(size, label)] = run(spec)
+            summaries.setdefault(f"{size:g}", {})[label] = _summary(outcomes[(size, label)])
+    for label, mode in (("spike", "fault"), ("spike_on_alarm", "alarm")):
+        progress(f"run: one-sample disturbance, substitution on {mode}")
+        outcomes[label] = run(Run(size_deg=D.FAULT_SIZES_DEG[-1], profile="pulse", length=1, substitute_on=mode))
+        summaries[label] = _summary(outcomes[label])
+    return outcomes, summaries
+
+
+def _learning(u: np.ndarray, outcome) -> dict:
+    """How much the filter learns: input power, mu M P_u, adaptation time, weights and prediction."""
+    k = outcome.k
+    before = (k >= 0) & (k < D.FAULT_SAMPLE)
+    deviation = np.degrees(outcome.result["y"]["psi"][before]) - D.SET_POINT_DEG
+    error = np.degrees(outcome.monitor("e_psi")[before])
+    power = float(np.mean(u ** 2))
+    return {"input_power": power, "mu_M_P_u": D.MU * D.ORDER * power, "mu_bound": mu_bound(D.ORDER, power),
+            "adaptation_samples": 1.0 / (2.0 * D.MU * power),
+            "rms_measured_deviation_deg": float(np.sqrt(np.mean(deviation ** 2))),
+            "rms_prediction_error_deg": float(np.sqrt(np.mean(error ** 2)))}
+
+
+def build(out_dir: Path, progress) -> None:
+    """Run the reproduction and the detection study, export C, check the claims, write the report."""
+    outcomes, summaries = _runs(progress)
+    progress(f"detection study: {2 * 100} runs over noise seeds, ROC over thresholds")
+    study = detection_study()
+    progress("C package of the monitor: write, compile, compare")
+    c = c_package(lms_set(), out_dir / "c")
+    progress("machine-checked claims")
+    claims = claim_rows(lms_claims())
+    progress("figures")
+    criteria_figure(outcomes[(30.0, "ftc")], out_dir / "fig3_criteria.svg")
+    heading_figure({f"+{s:g} deg": outcomes[(s, "no_ftc")] for s in D.FAULT_SIZES_DEG},
+                   out_dir / "fig4a_heading_without_ftc.svg", "Without fault-tolerant control", substitute=False)
+    heading_figure({f"+{s:g} deg": outcomes[(s, "ftc")] for s in D.FAULT_SIZES_DEG},
+                   out_dir / "fig4b_heading_with_ftc.svg",
+                   "With fault-tolerant control (substitution once the fault is confirmed)", substitute=True)
+    roc_figure(study.roc, out_dir / "roc.svg")
+    delay_figure(study.delays, out_dir / "detection_delay.svg")
+    paper_run = summaries["30"]["ftc"]
+    ftc = {size: summaries[size]["ftc"]["max_abs_heading_error_deg"] for size in ("30", "20", "10")}
+    results = {
+        "eps2_first_alarm_sample": paper_run["eps2_first_alarm_sample"],
+        "R_first_alarm_sample": paper_run["R_first_alarm_sample"],
+        "heading_without_ftc_deg": {size: summaries[size]["no_ftc"]["settled_heading_deg"] for size in ftc},
+        "max_abs_heading_error_with_ftc_deg": ftc,
+        "max_abs_heading_error_with_ftc_on_alarm_deg": {size: summaries[size]["ftc_on_alarm"][
+            "max_abs_heading_error_deg"] for size in ftc},
+        "spike_classified_as": _classified(summaries["spike"]),
+        "spike_substituted": summaries["spike"]["substituted_from_sample"] is not None,
+        "runs": summaries, "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
+        "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
+                  "nominal": study.delays, "r0_grid": list(R0_GRID)},
+        "paper": PAPER, "c": c, "claims": claims, "negative_factor": NEGATIVE_FACTOR,
+        "choices": {"eps0_deg2": D.EPS0_DEG2, "r0": D.R0, "window": D.WINDOW, "hold": D.HOLD, "confirm": D.CONFIRM,
+                    "bandwidth_rad_per_s": D.BANDWIDTH, "compass_noise_deg": D.COMPASS_NOISE_DEG,
+                    "torque_noise_N_m": D.TORQUE_NOISE, "warm_up": D.WARM_UP, "record": D.RECORD,
+                    "kp_per_rad": D.design().kp, "kp_per_deg": D.design().kp * math.pi / 180.0},
+    }
+    write_json(out_dir / "results.json", results)
+    (out_dir / "report.md").write_text(report_text(results, paper("zhu-lms")))
+
+
+def _classified(summary: dict) -> str:
+    """"fault" when the spike run confirmed a fault, "disturbance" when it released the freeze, else "none"."""
+    whats = [what for _, what in summary["events"]]
+    if any(w.startswith("R alarm") for w in whats):
+        return "fault"
+    return "disturbance" if any(w.startswith("no R alarm") for w in whats) else "none"
