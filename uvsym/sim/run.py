@@ -16,6 +16,7 @@ says where its per-sample input w holds them: ``correction_columns``, ``substitu
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass
@@ -25,14 +26,15 @@ import casadi as ca
 import numpy as np
 
 from uvsym.codegen import compile_roll, find_compiler
-from uvsym.errors import CodegenError, SimulationError
+from uvsym.errors import CodegenError, SimulationError, UvsymError
 from uvsym.observers.ftc import Correction
 from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
 
-__all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop"]
+__all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop", "check_memory", "memory_needed"]
 
 METHODS = ("fast", "cvodes", "idas", "rk", "collocation")
+MAX_SAMPLES = 1e12  # beyond any machine's memory at 8 bytes a sample and signal
 # samples per call between progress reports (no supervisor): the fast path pays per call, the
 # integrators step in Python anyway
 CHUNK = {"fast": 10000, "integrator": 100}
@@ -61,11 +63,20 @@ class Supervisor(Protocol):
 
 def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
-                    compiled: bool = True, progress=None) -> tuple[SimResult, dict]:
+                    compiled: bool = True, progress=None, guard=None) -> tuple[SimResult, dict]:
     """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
 
-    The decision columns of W are overwritten by the supervisor's decisions. Returns the
-    result (samples at every grid time, meta without the caller's part) and timing information.
+    The decision columns of W are overwritten by the supervisor's decisions. ``guard(t, out)``
+    (t: (k,) s, out: (k, n_out) logged rows) raises a typed error for samples outside the model's
+    domain (e.g. a kinematic singularity); it sees every chunk, before the finiteness check, so the
+    cause is named rather than its NaN. Returns the result (samples at every grid time, meta
+    without the caller's part) and timing information.
+
+    Raises
+    ------
+    SimulationError
+        For an unknown method or supervisor period, or a loop whose signals become non-finite
+        (names the first signal entry and the time).
     """
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
@@ -85,10 +96,15 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     for start in range(0, N, chunk):
         k = min(chunk, N - start)
         z = advance(z, W[start:start + k], outputs[start:start + k])
-        if not np.all(np.isfinite(z)):
-            bad = np.flatnonzero(~np.all(np.isfinite(outputs[start:start + k]), axis=1))
+        rows = outputs[start:start + k]
+        finite = np.all(np.isfinite(rows), axis=1)
+        bad = np.flatnonzero(~finite)
+        if guard is not None:
+            guard(W[start:start + (bad[0] if bad.size else k), 0], rows[:bad[0] if bad.size else k])
+        if bad.size or not np.all(np.isfinite(z)):
             first = start + (bad[0] if bad.size else k)
-            raise SimulationError(f"the loop diverged: its signals are non-finite from t = {first * loop.dt:.6g} s "
+            what = _first_non_finite(loop, outputs[first]) if bad.size else "its state"
+            raise SimulationError(f"the loop diverged: {what} is non-finite from t = {first * loop.dt:.6g} s "
                                   f"({method}); look for an unstable loop (gains, signs), a model that gives NaN "
                                   "there, or too large a step")
         if supervisor is not None:
@@ -104,6 +120,15 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     signals = {name: Signal(outputs[:, sl].copy(), labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
     return SimResult(W[:, 0].copy(), signals, {}), timing
+
+
+def _first_non_finite(loop: SampledLoop, row: np.ndarray) -> str:
+    """``signal.label (value)`` of the first non-finite entry of one logged row."""
+    column = int(np.flatnonzero(~np.isfinite(row))[0])
+    for name, (sl, labels, _) in loop.signals.items():
+        if sl.start <= column < sl.stop:
+            return f"{name}.{labels[column - sl.start]} ({row[column]})"
+    return f"logged entry {column} ({row[column]})"
 
 
 def _decision_columns(loop: SampledLoop, decision) -> tuple[slice | list[int], np.ndarray]:
@@ -184,7 +209,47 @@ def grid(duration: float, dt: float) -> int:
     """Number of samples N with N dt = duration; SimulationError unless dt divides duration."""
     if not (duration > 0.0 and dt > 0.0 and math.isfinite(duration)):
         raise SimulationError(f"duration and step must be positive and finite, got {duration} s and {dt} s")
+    if not duration / dt < MAX_SAMPLES:
+        raise SimulationError(f"duration {duration} s at step {dt} s is {duration / dt:.3g} samples, more than "
+                              f"{MAX_SAMPLES:.0e} (no machine holds them); shorten the run or lengthen the step")
     N = round(duration / dt)
     if abs(N * dt - duration) > 1e-9 * duration:
         raise SimulationError(f"step {dt} s does not divide duration {duration} s")
     return N
+
+
+def memory_needed(samples: int, loop: SampledLoop) -> int:
+    """Bytes a run of ``samples`` samples holds at once: the per-sample inputs W, the logged outputs
+    and the result's copy of them (float64)."""
+    return 8 * samples * (loop.n_w + 2 * loop.discrete.size1_out("out"))
+
+
+def available_memory() -> int | None:
+    """Bytes the system can still give (MemAvailable of /proc/meminfo, else physical memory); None if unknown."""
+    try:
+        with open("/proc/meminfo") as handle:
+            for line in handle:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def check_memory(needed: int, what: str, error: type[UvsymError] = SimulationError) -> None:
+    """``error`` with both figures when ``needed`` bytes exceed what the machine has available."""
+    available = available_memory()
+    if available is not None and needed > available:
+        raise error(f"{what} needs {_bytes(needed)} of memory, {_bytes(available)} are available; shorten the "
+                    "run or lengthen the step")
+
+
+def _bytes(count: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+        if count < 1024 or unit == "EiB":
+            return f"{count:.3g} {unit}"
+        count /= 1024
+    return f"{count:.3g} EiB"

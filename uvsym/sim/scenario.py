@@ -15,12 +15,15 @@ from pathlib import Path
 
 import numpy as np
 
-from uvsym.errors import FaultError, ModelError, ScenarioError, UnknownNameError
+from uvsym.errors import FaultError, KinematicsError, ModelError, ObserverError, ScenarioError, UnknownNameError
 from uvsym.faults import ActuatorFault, Profile, SensorFault, actuator_kind
+from uvsym.kinematics import Tzyx
 from uvsym.models.model import Model
 from uvsym.models.registry import vehicle
-from uvsym.observers import FORMS, KINDS
+from uvsym.observers import FORMS, KINDS, actuator_observer
+from uvsym.observers.gains import design_gains
 from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
+from uvsym.sim.run import MAX_SAMPLES, check_memory
 
 __all__ = ["Scenario", "ObserverSpec", "load_scenario", "parse_scenario", "read_scenario_file",
            "shipped_scenarios"]
@@ -173,6 +176,8 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
         raise ScenarioError(f"vehicle: {exc}") from None
     dof, m = model.dof, model.n_inputs
     duration, step = top.number("duration", positive=True), top.number("step", positive=True)
+    observer_items = top.raw("observers", [])
+    _check_size(duration, step, model, len(observer_items) if isinstance(observer_items, list) else 0)
     if abs(round(duration / step) * step - duration) > 1e-9 * duration:
         raise ScenarioError(f"step: {step} s does not divide duration {duration} s")
     seed = top.raw("seed", 0)
@@ -181,6 +186,11 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
 
     initial = top.table("initial") or _Fields({}, "initial")
     eta0 = initial.vector("eta", dof, [0.0] * dof)
+    if dof == 6:
+        try:
+            Tzyx(eta0[3], eta0[4])
+        except KinematicsError as exc:
+            raise ScenarioError(f"initial.eta: theta (entry 5): {exc}") from None
     nu0 = initial.vector("nu", dof, [0.0] * dof)
     actuators0 = initial.vector("actuators", m)
     initial.done()
@@ -192,8 +202,8 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
     current.done()
 
     controller = _controller(top.table("controller"), model)
-    actuator_faults, sensor_faults = _faults(top.tables("faults"), model)
-    observers = tuple(_observer(f, dof) for f in top.tables("observers"))
+    actuator_faults, sensor_faults = _faults(top.tables("faults"), model, duration)
+    observers = _observers(top.tables("observers"), model)
     top.done()
     return Scenario(name=name, description=description, model=model, duration=duration, step=step, seed=seed,
                     eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c),
@@ -223,6 +233,11 @@ def _controller(fields: _Fields | None, model: Model) -> Autopilot:
         points = path_fields.raw("waypoints")
         if not isinstance(points, list) or not all(isinstance(p, list) and len(p) == 2 for p in points):
             raise ScenarioError("controller.path.waypoints: expected a list of [north, east] pairs (m)")
+        for i, point in enumerate(points):
+            for j, v in enumerate(point):
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise ScenarioError(f"controller.path.waypoints[{i}][{j}]: expected a finite number (m), "
+                                        f"got {v!r}")
         path = LineOfSight(tuple(tuple(float(v) for v in p) for p in points),
                            lookahead=path_fields.number("lookahead", 10.0, positive=True),
                            acceptance=path_fields.number("acceptance", 2.0, minimum=0.0),
@@ -254,32 +269,75 @@ def _profile(fields: _Fields) -> Profile:
     return Profile(**kwargs)
 
 
-def _faults(items: list[_Fields], model: Model):
+def _faults(items: list[_Fields], model: Model, duration: float):
+    """The actuator and sensor faults; ScenarioError naming the field of one that is malformed or
+    can never act (onset outside [0, duration), a value that changes nothing, a negative factor)."""
     actuator, sensor = [], []
     for fields in items:
         try:
             if fields.has("actuator"):
                 label = fields.text("actuator", choices=model.input_labels)
-                actuator.append(ActuatorFault(model.input_labels.index(label), fields.text("kind"),
-                                              fields.number("value"), _profile(fields)))
+                fault = ActuatorFault(model.input_labels.index(label), fields.text("kind"),
+                                      fields.number("value"), _profile(fields))
+                _check_actuator_value(fields, fault)
+                actuator.append(fault)
             elif fields.has("sensor"):
                 label = fields.text("sensor", choices=model.state_labels)
-                sensor.append(SensorFault(model.state_labels.index(label), fields.text("kind"),
-                                          fields.number("value", 0.0), _profile(fields)))
+                fault = SensorFault(model.state_labels.index(label), fields.text("kind"),
+                                    fields.number("value", 0.0), _profile(fields))
+                sensor.append(fault)
             else:
                 raise ScenarioError(f"{fields.path}: give either actuator = <input label> or sensor = <state label>")
         except FaultError as exc:
             raise ScenarioError(f"{fields.path}: {exc}") from None
+        if not 0.0 <= fault.profile.onset < duration:
+            raise ScenarioError(f"{fields.path}.onset: {fault.profile.onset:g} s is outside the run [0, {duration:g}) "
+                                "s; the fault would never act")
         fields.done()
     return tuple(actuator), tuple(sensor)
 
 
-def _observer(fields: _Fields, dof: int) -> ObserverSpec:
-    kind = fields.text("kind", choices=KINDS)
-    spec = ObserverSpec(kind=kind, form=fields.text("form", "paper", choices=FORMS),
-                        time_constant=fields.number("time_constant", positive=True),
-                        tau_d=None if not fields.has("tau_d") else tuple(fields.vector("tau_d", dof)))
-    if actuator_kind(kind).scales and spec.tau_d is None:
-        raise ScenarioError(f"{fields.path}.tau_d: the {kind} observer's gain design needs a nominal tau_d")
-    fields.done()
-    return spec
+def _check_actuator_value(fields: _Fields, fault: ActuatorFault) -> None:
+    kind = fault.kind_object
+    if kind.name == "proportional" and fault.value < 0.0:
+        raise ScenarioError(f"{fields.path}.value: a proportional factor scales what the actuator delivers (1 "
+                            f"healthy, 0 dead); {fault.value:g} would reverse it")
+    if kind.healthy is not None and fault.value == kind.healthy:
+        raise ScenarioError(f"{fields.path}.value: {fault.value:g} is the healthy value of a {kind.name} fault; "
+                            "this fault changes nothing")
+
+
+def _observers(items: list[_Fields], model: Model) -> tuple[ObserverSpec, ...]:
+    """The observers, one per kind; ScenarioError naming the field of a duplicate or of a nominal tau_d
+    that is missing or leaves every channel unobservable."""
+    specs: dict[str, tuple[str, ObserverSpec]] = {}
+    for fields in items:
+        kind = fields.text("kind", choices=KINDS)
+        if kind in specs:
+            raise ScenarioError(f"{fields.path}.kind: a {kind} observer is already listed ({specs[kind][0]}); "
+                                "each kind runs once")
+        spec = ObserverSpec(kind=kind, form=fields.text("form", "paper", choices=FORMS),
+                            time_constant=fields.number("time_constant", positive=True),
+                            tau_d=None if not fields.has("tau_d") else tuple(fields.vector("tau_d", model.dof)))
+        if actuator_kind(kind).scales and spec.tau_d is None:
+            raise ScenarioError(f"{fields.path}.tau_d: the {kind} observer's gain design needs a nominal tau_d")
+        try:
+            design_gains(actuator_observer(model, kind, spec.form), spec.time_constant, spec.tau_d)
+        except ObserverError as exc:
+            raise ScenarioError(f"{fields.path}.tau_d: {exc}") from None
+        fields.done()
+        specs[kind] = (fields.path, spec)
+    return tuple(spec for _, spec in specs.values())
+
+
+def _check_size(duration: float, step: float, model: Model, n_observers: int) -> None:
+    """ScenarioError naming ``step`` or ``duration`` when the run's samples cannot be held: more than
+    MAX_SAMPLES, or more bytes than the machine has (a lower bound: true and measured states, five
+    input-sized command signals, the sensor faults, tau_d and each observer's estimates)."""
+    samples = duration / step + 1
+    field = "step" if step < 1e-6 else "duration"
+    what = f"{field}: {duration:g} s at step {step:g} s ({samples:.3g} samples)"
+    if not samples < MAX_SAMPLES:
+        raise ScenarioError(f"{what} is more than {MAX_SAMPLES:.0e} samples; shorten the run or lengthen the step")
+    per_sample = 3 * 2 * model.dof + 5 * model.n_inputs + model.dof * (1 + n_observers)
+    check_memory(8 * int(samples) * per_sample, what, ScenarioError)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
-from uvsym.errors import SimulationError
+from uvsym.errors import KinematicsError, SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
+from uvsym.kinematics import Tzyx
 from uvsym.models.model import Model
 from uvsym.observers import ActuatorObserver, actuator_observer
 from uvsym.observers.base import Observer
@@ -16,7 +17,7 @@ from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.controllers import Autopilot
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
-from uvsym.sim.run import Supervisor, grid, run_closed_loop
+from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
 
 __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers", "current_profile"]
@@ -52,11 +53,17 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     N = grid(duration, dt)
     env = np.asarray(current, dtype=float)
     per_sample(env, 2, N, "current (V_c m/s, beta_c rad)")
+    dof, m, n = model.dof, model.n_inputs, 2 * model.dof
+    x0 = np.concatenate([_vector(eta0, dof, "eta0"), _vector(nu0, dof, "nu0")])
+    if dof == 6:
+        try:
+            Tzyx(x0[3], x0[4])
+        except KinematicsError as exc:
+            raise KinematicsError(f"eta0: {exc}") from None
     loop = build_closed_loop(model, controller, dt, actuator_faults=tuple(actuator_faults),
                              sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
                              current=tuple(env) if env.shape == (2,) else None)
-    dof, m, n = model.dof, model.n_inputs, 2 * model.dof
-    x0 = np.concatenate([_vector(eta0, dof, "eta0"), _vector(nu0, dof, "nu0")])
+    check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
     W = sample_inputs(loop.n_w, N, dt, n, seed)  # one row per sample: [t, noise, V_c, beta_c, vec(S), o]
     W[:, 1 + n:3 + n] = env.reshape(-1, 2)
     W[:, 3 + n:] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
@@ -76,12 +83,36 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
             [measured[n] for n in obs.reads_y.names], [desired[n] for n in obs.reads_u.names])
 
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
-                                     compiled=compiled, progress=progress)
+                                     compiled=compiled, progress=progress,
+                                     guard=_attitude_guard(loop) if dof == 6 else None)
     meta = {"vehicle": model.name, "method": method, "dt_s": dt, "duration_s": duration, "substeps": substeps,
             "seed": seed, "observers": [obs.name for obs in observers],
             "actuator_faults": [fault_summary(f, model.input_labels[f.actuator]) for f in actuator_faults],
             "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults], **timing}
     return SimResult(result.t, result.signals, meta)
+
+
+def _attitude_guard(loop):
+    """guard(t, out) for :func:`run_closed_loop`: SimulationError at the first sample where the true
+    pitch reaches or crosses +-90 deg (cos theta below 1e-9 or changing sign), where the Euler-angle
+    kinematics eta' = J(eta) nu are singular and the attitude that follows is meaningless."""
+    rows, labels, _ = loop.signals["x"]
+    column = rows.start + labels.index("theta")
+    previous = [None]
+
+    def guard(t: np.ndarray, out: np.ndarray) -> None:
+        cos_theta = np.cos(out[:, column])
+        before = np.concatenate([[cos_theta[0] if previous[0] is None else previous[0]], cos_theta[:-1]])
+        hit = np.flatnonzero((np.abs(cos_theta) < 1e-9) | (np.sign(cos_theta) != np.sign(before)))
+        if hit.size:
+            k = hit[0]
+            raise SimulationError(f"kinematic singularity at t = {t[k]:.6g} s: the state x.theta = "
+                                  f"{np.degrees(out[k, column]):.6g} deg reached pitch +-90 deg, where "
+                                  "eta' = J(eta) nu is undefined (Euler angles); the run is stopped there")
+        if cos_theta.size:
+            previous[0] = cos_theta[-1]
+
+    return guard
 
 
 def _vector(values, size: int, name: str) -> np.ndarray:

@@ -7,7 +7,7 @@ import numpy as np
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
-from uvsym.sim.run import Supervisor, grid, run_closed_loop
+from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
@@ -59,6 +59,7 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     N = grid(duration, dt)
     loop = interconnect(plant, blocks, dt=dt, actuator_faults=tuple(actuator_faults),
                         sensor_faults=tuple(sensor_faults), substitutions=substitutions, substeps=substeps, p=p)
+    check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
     W = sample_inputs(loop.n_w, N, dt, plant.y.size, seed)  # one row per sample: [t, noise, d, switches]
     W[:, loop.env_columns] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
     z0 = initial_state(loop, x0, W[0])
