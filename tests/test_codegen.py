@@ -49,7 +49,7 @@ def _inputs(functions, rng, special: bool):
     records = []
     for index, e in enumerate(functions):
         f = e.function
-        for _ in range(25):
+        for _ in range(12):
             args = [rng.normal(scale=[3.0, 0.5, 2.0, 50.0, 1.0, 0.05][min(i, 5)], size=f.nnz_in(i))
                     for i in range(f.n_in())]
             args[-1] = np.abs(args[-1]) + 0.01 if f.name_in(f.n_in() - 1) == "dt" else np.abs(args[-1]) + 0.1
