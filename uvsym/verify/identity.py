@@ -186,7 +186,8 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
         return Certificate(claim, set_description, method, status, expected, seconds=time.perf_counter() - started,
                            **fields)
 
-    entries = _entries(lhs - rhs)
+    left, right = _entries(lhs), _entries(rhs)
+    entries = [a - b for a, b in zip(left, right)]
     outcome = _symbolic(entries, symbolic_seconds)
     if outcome == "exact":
         return certificate("exact rational arithmetic on the double constants (converted exactly), transcendental "
@@ -195,8 +196,7 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
         return certificate("sympy simplification to zero, rational constants (exact)", "proved")
     sym = [sp.Symbol(s.name(), real=True) for s in symbols]
     numeric = sp.lambdify(sym, entries, modules="mpmath")
-    magnitude = sp.lambdify(sym, [_magnitude(a) + _magnitude(b) for a, b in zip(_entries(lhs), _entries(rhs))],
-                            modules="mpmath")
+    magnitude = sp.lambdify(sym, [_magnitude(a) + _magnitude(b) for a, b in zip(left, right)], modules="mpmath")
 
     def relative(point, digits):
         with mpmath.workdps(digits):

@@ -169,16 +169,24 @@ def discrete_lyapunov_decrease(claim: str, Ad: np.ndarray, rho: float, set_descr
                            counterexample={"A": Ad.tolist(), "eigenvalue_modulus": radius, "rho": float(rho),
                                            "eigenvector_real": vector, "exact_test": "Schur"})
     scaled = Ad / (0.5 * (min(radius, float(rho)) + float(rho)))
-    P = solve_discrete_lyapunov(scaled.T, np.eye(Ad.shape[0]))
-    P_exact = _rational(0.5 * (P + P.T))
-    n, r2 = Ad.shape[0], rho_exact ** 2
-    AtPA = matmul(matmul([list(c) for c in zip(*A_exact)], P_exact), A_exact)
-    ok_P, margin_P = exact_positive_definite(P_exact)
-    ok_S, margin_S = exact_positive_definite([[r2 * P_exact[i][j] - AtPA[i][j] for j in range(n)] for i in range(n)])
-    if ok_P and ok_S:
-        return Certificate(claim, set_description, "discrete Lyapunov (Stein) inequality, P from scipy, re-checked "
-                           "by exact rational LDL^T", "proved", expected, margin=float(min(margin_P, margin_S)),
-                           seconds=time.perf_counter() - started, details={"spectral_radius": radius, "P": P.tolist()})
+    try:
+        with warnings.catch_warnings():  # an ill-conditioned P is re-checked exactly below
+            warnings.simplefilter("ignore")
+            P = solve_discrete_lyapunov(scaled.T, np.eye(Ad.shape[0]))
+    except (np.linalg.LinAlgError, ValueError):
+        P = None
+    if P is not None and np.all(np.isfinite(P)):
+        P_exact = _rational(0.5 * (P + P.T))
+        n, r2 = Ad.shape[0], rho_exact ** 2
+        AtPA = matmul(matmul([list(c) for c in zip(*A_exact)], P_exact), A_exact)
+        ok_P, margin_P = exact_positive_definite(P_exact)
+        ok_S, margin_S = exact_positive_definite([[r2 * P_exact[i][j] - AtPA[i][j] for j in range(n)]
+                                                  for i in range(n)])
+        if ok_P and ok_S:
+            return Certificate(claim, set_description, "discrete Lyapunov (Stein) inequality, P from scipy, "
+                               "re-checked by exact rational LDL^T", "proved", expected,
+                               margin=float(min(margin_P, margin_S)), seconds=time.perf_counter() - started,
+                               details={"spectral_radius": radius, "P": P.tolist()})
     return Certificate(claim, set_description, "Schur test in exact rationals (spectral radius < rho, so P exists by "
                        "Lyapunov's theorem)", "proved", expected, seconds=time.perf_counter() - started,
                        details={"spectral_radius": radius, "stein": "scipy's P failed the exact re-check"})

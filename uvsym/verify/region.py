@@ -118,8 +118,9 @@ def _cube_certificate(decrease: _Decrease, rho: float) -> tuple[bool, Fraction |
 def _equilibrium_counterexample(decrease: _Decrease, gradient: Intervals, hessian: Intervals,
                                 scale: np.ndarray) -> np.ndarray | None:
     """A point near 0 where W > 0 rigorously, when the gradient or Hessian of W at 0 allows one."""
-    g = 0.5 * (gradient.lo[0] + gradient.hi[0])
-    H = 0.5 * (hessian.lo[0] + hessian.hi[0]).reshape(decrease.n, decrease.n)
+    with np.errstate(invalid="ignore"):  # inf - inf where undefined: caught just below
+        g = 0.5 * (gradient.lo[0] + gradient.hi[0])
+        H = 0.5 * (hessian.lo[0] + hessian.hi[0]).reshape(decrease.n, decrease.n)
     if not (np.all(np.isfinite(g)) and np.all(np.isfinite(H))):
         return None
     eigenvalues, vectors = np.linalg.eigh(0.5 * (H + H.T))

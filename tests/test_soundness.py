@@ -1,0 +1,175 @@
+"""Soundness of uvsym verify: borderline claims with known truth never come back proved when false
+or refuted when true, at scales from 1e-170 to 1e160; each finding of the soundness review has
+its regression here; bad inputs get typed errors. (A larger sample: benchmarks/soundness.py.)"""
+
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from uvsym.errors import VerificationError
+from uvsym.testing import assert_checked, assert_proved, assert_refuted
+from uvsym.verify import Certificate, lyapunov_decrease, prove_identity, region_decrease, synthesize_observer_gain
+from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
+from uvsym.verify.interval import IntervalFunction
+from uvsym.verify.lyapunov import discrete_lyapunov_decrease
+
+
+def _unsound(status: str, holds: bool) -> bool:
+    return (status == "proved" and not holds) or (status == "refuted" and holds)
+
+
+def test_borderline_region_claims_are_never_decided_wrongly():
+    outcomes = []
+    for case in region_cases(36, seed=11):
+        certificate = region_decrease(case.name, *case.arguments(), max_boxes=20_000)
+        assert not _unsound(certificate.status, case.holds), (case, certificate)
+        if certificate.status == "refuted":  # the counterexample violates the claim by the case's own formula
+            assert case.W(list(certificate.counterexample["x"].values())) > 0
+        outcomes.append(certificate.status)
+    rate = outcomes.count("inconclusive") / len(outcomes)
+    print(f"region claims: {len(outcomes)} cases, inconclusive rate {rate:.2f}")
+    assert rate < 0.5 and "proved" in outcomes and "refuted" in outcomes
+
+
+def test_borderline_linear_claims_are_never_decided_wrongly():
+    statuses = []
+    for case in linear_cases(60, seed=12):
+        continuous = lyapunov_decrease(case.name, [case.A], case.gamma, "one matrix")
+        discrete = discrete_lyapunov_decrease(case.name, case.A, case.rho, "one matrix")
+        assert not _unsound(continuous.status, case.holds), (case, continuous)
+        assert not _unsound(discrete.status, case.holds_discrete), (case, discrete)
+        statuses += [continuous.status, discrete.status]
+    assert statuses.count("inconclusive") == 0 and {"proved", "refuted"} <= set(statuses)
+
+
+def test_false_identities_of_every_class_are_never_proved():
+    for case in identity_cases(10, seed=13):
+        certificate = prove_identity(case.kind, case.lhs, case.rhs, case.inputs, "all x", symbolic_seconds=1.0)
+        assert not _unsound(certificate.status, case.holds), (case.kind, certificate)
+
+
+def test_region_claim_failing_near_the_equilibrium_at_any_scale():
+    """Finding (a): x' = -x + b x^2 fails for x beyond s (b = 0.5 / s, gamma = 1): inside the cube
+    the interval Hessian is indefinite; at 1e-170 it used to be proved, at 1e160 to raise."""
+    for scale in (1e-170, 1e-20, 1.0, 1e20, 1e160):
+        x = ca.SX.sym("x")
+        certificate = region_decrease(f"scale {scale:g}", x * x, -x + (0.5 / scale) * x ** 2, x, 1.0,
+                                      [-3 * scale], [3 * scale], 2.5 * scale, max_boxes=20_000)
+        assert certificate.status in ("refuted", "inconclusive"), (scale, certificate)
+        if certificate.status == "refuted":
+            point = list(certificate.counterexample["x"].values())[0] / scale
+            assert 2 * point * (-point + 0.5 * point ** 2) + point ** 2 > 0  # W / s^2 at the point
+
+
+def test_region_claim_with_a_domain_violation_is_not_proved():
+    """Finding (b): sqrt(x) is NaN for x < 0: V' is undefined on half the box."""
+    x = ca.SX.sym("x")
+    certificate = region_decrease("sqrt", x * x, -x - 0.01 * ca.sqrt(x), x, 0.5, [-1.0], [1.0], 0.1)
+    assert certificate.status == "inconclusive" and "undefined" in certificate.reason
+    logged = region_decrease("log1p", x * x, -x + 0.01 * x * ca.log1p(x), x, 0.5, [-2.0], [1.0], 0.1)
+    assert logged.status != "proved"
+
+
+@pytest.mark.parametrize("g", [ca.sin, ca.tanh, lambda v: ca.exp(v) - 1])
+def test_transcendental_loops_are_proved_at_the_equilibrium(g):
+    """Library results at 0 are exact (sin 0 = 0, exp 0 = 1), so W(0) = 0 and the Taylor cube applies."""
+    x = ca.SX.sym("x")
+    assert_proved(region_decrease("g", x * x, -g(x), x, 0.5, [-1.0], [1.0], 0.2))
+
+
+def test_claim_failing_far_from_the_origin_is_refuted_even_when_the_cube_fails():
+    """gamma = 2 a: W = 2 b x^3 has a zero Hessian at 0, the cube never certifies; the
+    branch-and-bound still finds where W > 0."""
+    x = ca.SX.sym("x")
+    refuted = region_decrease("cubic", x * x, -x + 0.3 * x ** 2, x, 2.0, [-1.0], [1.0], 0.5, expected="refuted")
+    assert_refuted(refuted)
+    point = refuted.counterexample["x"]["x"]
+    assert point > 0 and 0.6 * point ** 3 > 0
+
+
+def test_companion_matrix_of_a_repeated_root_is_decided_exactly():
+    """(s + 1)^8: numpy's eigenvalues scatter by ~0.02 around -1; the claim holds for gamma < 1."""
+    coefficients = np.poly(-np.ones(8))
+    A = np.zeros((8, 8))
+    A[0, :], A[1:, :-1] = -coefficients[1:], np.eye(7)
+    assert max(np.linalg.eigvals(A).real) > -0.99  # what used to refute the true claim
+    assert_proved(lyapunov_decrease("(s+1)^8", [A], 0.99, "one matrix"))
+    assert_refuted(lyapunov_decrease("(s+1)^8", [A], 1.0, "one matrix"))
+    assert_refuted(discrete_lyapunov_decrease("(s+1)^8 sampled", A, 1.0, "one matrix"))
+    assert_proved(discrete_lyapunov_decrease("(s+1)^8 sampled", A, 1.01, "one matrix"))
+
+
+def test_synthesis_certifies_the_exact_closed_loop():
+    A = np.array([[0.0, 1.0], [-2.0, -0.1]])
+    C = np.array([[1.0, 0.0]])
+    design = synthesize_observer_gain(A, C, decay=1.0)
+    assert "exact" in design.certificate.set
+    # independent oracle: the closed loop in exact rationals, its trace and determinant (2 x 2: Hurwitz
+    # at rate 1 iff tr(A + I) < 0 and det(A + I) > 0)
+    F = [[Fraction(float(A[i][j])) - sum(Fraction(float(design.L[i][k])) * Fraction(float(C[k][j]))
+                                         for k in range(1)) + (1 if i == j else 0) for j in range(2)] for i in range(2)]
+    assert F[0][0] + F[1][1] < 0 and F[0][0] * F[1][1] - F[0][1] * F[1][0] > 0
+
+
+def test_identity_findings():
+    x = ca.SX.sym("x")
+    relative = prove_identity("1e-13", x * (1 + 1e-13), x, [x], "all x")
+    assert relative.status == "checked" and not relative.proved  # sampling is evidence, not a proof
+    far = x + ca.if_else(ca.fabs(x) > 1e6, 1e-3 * x, 0)
+    assert prove_identity("far", far, x, [x], "all x").status == "refuted"
+    spot = x + ca.if_else(ca.fabs(x - 7) < 0.01, 1, 0)
+    assert prove_identity("near 7", spot, x, [x], "all x").status != "proved"
+    assert_refuted(prove_identity("near 7, box", spot, x, [x], "6.99 <= x <= 7.01", box=([6.99], [7.01])))
+    masked = prove_identity("masked", ca.vertcat(1e9 * x, x * (1 + 1e-6)), ca.vertcat(1e9 * x, x), [x], "all x")
+    assert_refuted(masked)
+    assert masked.counterexample["entry"] == 1
+    started = time.perf_counter()
+    tanh = prove_identity("1 - tanh", 1 - ca.tanh(x + 100), 2 / (ca.exp(2 * (x + 100)) + 1), [x], "all x",
+                          symbolic_seconds=1.0)
+    assert tanh.status != "refuted" and time.perf_counter() - started < 20
+    assert_checked(tanh)
+    assert_proved(prove_identity("rational", (x ** 2 - 1) / (x - 1), x + 1, [x], "x != 1"))
+
+
+def test_assert_proved_refuses_checked_evidence():
+    with pytest.raises(AssertionError, match="not proved"):
+        assert_proved(Certificate("claim", "set", "sampled", "checked"))
+
+
+def test_bad_inputs_get_typed_errors_naming_the_argument():
+    x, p = ca.SX.sym("x", 2), ca.SX.sym("p")
+    V, f = ca.dot(x, x), -x
+    box = ([-1.0, -1.0], [1.0, 1.0])
+    cases = [
+        (lambda: region_decrease("c", V, f, x, 0.5, [np.nan, -1], [1, 1], 0.1), "lower"),
+        (lambda: region_decrease("c", V, f, x, 0.5, [-1, -1, -1], [1, 1], 0.1), "lower"),
+        (lambda: region_decrease("c", V, f, x, np.inf, *box, 0.1), "gamma"),
+        (lambda: region_decrease("c", V, f, x, 0.5, *box, np.nan), "rho"),
+        (lambda: region_decrease("c", V, -x * p, x, 0.5, *box, 0.1), "free symbol"),
+        (lambda: region_decrease("c", [1.0], f, x, 0.5, *box, 0.1), "V must be"),
+        (lambda: lyapunov_decrease("c", [np.array([[np.nan, 0], [0, -1.0]])], 0.5, "s"), r"vertices\[0\]"),
+        (lambda: lyapunov_decrease("c", np.eye(2), 0.5, "s"), "list of matrices"),
+        (lambda: lyapunov_decrease("c", [np.eye(2), np.eye(3)], 0.5, "s"), r"vertices\[1\]"),
+        (lambda: lyapunov_decrease("c", [[[1.0, 2.0]]], 0.5, "s"), r"vertices\[0\]"),
+        (lambda: lyapunov_decrease("c", [-np.eye(2)], np.nan, "s"), "gamma"),
+        (lambda: lyapunov_decrease("c", [], 0.5, "s"), "non-empty"),
+        (lambda: discrete_lyapunov_decrease("c", [[0.5, np.inf], [0, 0.5]], 1.0, "s"), "Ad"),
+        (lambda: discrete_lyapunov_decrease("c", np.eye(2) / 2, -1.0, "s"), "rho"),
+        (lambda: prove_identity("c", x, ca.vertcat(x, x), [x], "s"), "same shape"),
+        (lambda: prove_identity("c", x * p, x, [x], "s"), "p"),
+        (lambda: prove_identity("c", x, x, [x[0] + 1], "s"), "symbols only"),
+        (lambda: prove_identity("c", x, x, [x], "s", box=([0, np.nan], [1, 1])), "box"),
+        (lambda: synthesize_observer_gain([[np.nan]], [[1.0]], 1.0), "A"),
+        (lambda: synthesize_observer_gain(np.eye(2), np.ones((1, 3)), 1.0), "columns"),
+        (lambda: synthesize_observer_gain(-np.eye(2), np.ones((1, 2)), np.nan), "decay"),
+        (lambda: IntervalFunction(ca.Function("f", [x], [x]))([[np.nan, 0]], [[1, 1]]), "NaN"),
+        (lambda: Certificate("c", "s", "m", "maybe"), "status"),
+    ]
+    for call, message in cases:
+        with pytest.raises(VerificationError, match=message):
+            call()
