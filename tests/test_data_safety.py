@@ -82,3 +82,19 @@ def test_output_files_are_checked_as_files(tmp_path):
     with pytest.raises(PathError, match="it is a folder"):
         output_file(tmp_path, "the result")
     assert output_file(tmp_path / "sub" / "r.npz", "the result") == tmp_path / "sub" / "r.npz"
+
+
+def test_folders_that_cannot_be_made_are_typed_errors_before_any_work(tmp_path, monkeypatch, capsys):
+    from pathlib import Path
+
+    def refuse(self, *args, **kwargs):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "mkdir", refuse)
+    for argv, what in ((["simulate", "docking_faults", "--out", str(tmp_path / "new" / "run.npz")], "the result"),
+                       (["codegen", "motor-luenberger", "-o", str(tmp_path / "pkg")], "the C package"),
+                       (["report", "models", "--out", str(tmp_path / "reports")], "a report")):
+        assert main(argv) == 2
+        captured = capsys.readouterr()
+        assert f"cannot make the folder {tmp_path}" in captured.err and f"for {what}: Permission denied" in captured.err
+        assert "final state" not in captured.out  # refused before the run

@@ -24,7 +24,7 @@ from uvsym.derivation import (
 )
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
-from uvsym.paths import claim_folder, output_folder
+from uvsym.paths import claim_folder, make_folder, output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["BUILD_STAMP", "main"]
@@ -120,9 +120,10 @@ def _cmd_report(args) -> int:
     selected = _selected(args.names)
     out_root = output_folder(args.out, "reports")
     out_dirs = [claim_folder(out_root / study.name, f"the {study.name} report", "report", args.force)
-                for study in selected]  # every folder checked before any study runs
+                for study in selected]  # every folder checked, then made, before any study runs
+    for out_dir in out_dirs:
+        make_folder(out_dir, "a report")
     for index, (study, out_dir) in enumerate(zip(selected, out_dirs), 1):
-        out_dir.mkdir(parents=True, exist_ok=True)
 
         def progress(message: str, _name=study.name, _index=index) -> None:
             print(f"[{_index}/{len(selected)}] {_name}: {message}", file=sys.stderr, flush=True)
@@ -227,7 +228,7 @@ def _cmd_codegen(args) -> int:
     options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
     options |= _set_options(args.name, factory, args.set_options)
     observers = observer_set(args.name, **options)
-    claim_folder(args.out, "the C package", "package", args.force)
+    make_folder(claim_folder(args.out, "the C package", "package", args.force), "the C package")
     manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check)
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from uvsym.errors import PathError, UvsymError
 
-__all__ = ["output_folder", "claim_folder", "output_file", "OWNERS"]
+__all__ = ["output_folder", "claim_folder", "make_folder", "output_file", "OWNERS"]
 
 
 def output_folder(path, what: str, error: type[UvsymError] = UvsymError) -> Path:
@@ -64,13 +64,23 @@ def claim_folder(path, what: str, owner: str, force: bool = False) -> Path:
     return folder
 
 
+def make_folder(path, what: str) -> Path:
+    """The folder ``path``, made with its parents if missing; PathError naming it when it cannot be."""
+    folder = output_folder(path, what, PathError)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise PathError(f"cannot make the folder {folder} for {what}: {exc.strerror or exc}") from None
+    return folder
+
+
 def output_file(path, what: str, overwrite: bool = False) -> Path:
-    """``path`` checked before any work: in a folder that is (or can be made) a writable folder, not
-    a folder itself, no existing file unless ``overwrite`` (PathError naming the path)."""
+    """``path`` checked before any work: not a folder, its folder made if missing (PathError when it
+    cannot be), no existing file unless ``overwrite``."""
     path = Path(path)
     if path.is_dir():
         raise PathError(f"cannot write {what} to {path}: it is a folder")
-    output_folder(path.parent, what, PathError)
     if path.exists() and not overwrite:
         raise PathError(f"{path} exists; refusing to overwrite it (pass overwrite=True, or --force)")
+    make_folder(path.parent, what)
     return path

@@ -97,8 +97,8 @@ class SimResult:
 
     @staticmethod
     def check_path(path, overwrite: bool = False) -> Path:
-        """``path`` checked before a run writes it: a known suffix (SimulationError), a writable
-        folder, no existing file unless ``overwrite`` (PathError)."""
+        """``path`` checked before a run writes it: a known suffix (SimulationError), its folder made
+        if missing, no existing file unless ``overwrite`` (PathError)."""
         path = Path(path)
         _suffix(path)
         return output_file(path, "the result", overwrite)
@@ -109,7 +109,6 @@ class SimResult:
         path = self.check_path(path, overwrite)
         layout = [{"name": n, "labels": list(s.labels), "units": list(s.units)} for n, s in self.signals.items()]
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
             _WRITERS[path.suffix](self, path, layout)
         except OSError as exc:
             raise PathError(f"cannot write the result to {path}: {exc.strerror or exc}") from None
