@@ -157,4 +157,4 @@ def region_decay_claim(observer, plant, P, gamma: float, half_widths, cube: floa
     if quadratic is None:
         return certificate
     return replace(certificate, method=f"{certificate.method}; e' as its exact quadratic expansion (polynomial of "
-                                       "degree <= 2 in e, e'(0) = 0 proved by sympy)")
+                                       "degree <= 2 in e, e'(0) = 0 proved in exact rationals)")

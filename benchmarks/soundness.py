@@ -1,0 +1,115 @@
+"""Soundness of uvsym verify on generated claims with known truth: no proved-false, no refuted-true.
+
+Run ``python benchmarks/soundness.py [count]`` (default 1000 of each kind; on demand, not in CI);
+writes ``benchmarks/results/soundness.json`` with ``cases`` (claims checked), ``unsound`` (a
+``proved`` for a false claim, a ``refuted`` for a true one, or an interval bound that misses the
+exact value at a sampled point) and ``inconclusive_rate`` (region, linear and identity claims
+that were neither decided nor checked), per kind as well:
+
+- ``interval``: one operation of uvsym's interval kernel on random boxes of every kind
+  (straddling 0, subnormal, huge, zero width, anything), sampled points against mpmath;
+- ``region``: :func:`uvsym.verify.borderline.region_cases` through ``region_decrease``;
+- ``linear``: :func:`uvsym.verify.borderline.linear_cases`, each as a continuous
+  (``lyapunov_decrease``) and a discrete (``discrete_lyapunov_decrease``) claim;
+- ``identity``: :func:`uvsym.verify.borderline.identity_cases` through ``prove_identity``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from common import finish  # noqa: E402
+
+from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
+from uvsym.verify.enclosure_check import BOX_KINDS, OPERATIONS, enclosure_violations, random_box
+from uvsym.verify.identity import prove_identity
+from uvsym.verify.lyapunov import discrete_lyapunov_decrease, lyapunov_decrease
+from uvsym.verify.region import region_decrease
+
+RESULTS = Path(__file__).resolve().parent / "results" / "soundness.json"
+BINARY = {"add", "sub", "mul", "div", "fmin", "fmax"}
+
+
+def _tally(outcomes: list[tuple[str, bool]], seconds: float, examples: list[str]) -> dict:
+    """Counts of one kind: cases, unsound, statuses, inconclusive rate."""
+    statuses = [s for s, _ in outcomes]
+    unsound = [(s, holds) for s, holds in outcomes if (s == "proved" and not holds) or (s == "refuted" and holds)]
+    return {"cases": len(outcomes), "unsound": len(unsound), "seconds": round(seconds, 1),
+            "statuses": {s: statuses.count(s) for s in sorted(set(statuses))},
+            "inconclusive_rate": statuses.count("inconclusive") / max(1, len(statuses)), "unsound_examples": examples}
+
+
+def interval_kind(count: int, rng) -> dict:
+    started, outcomes, examples = time.perf_counter(), [], []
+    names = sorted(OPERATIONS)
+    for k in range(count):
+        name = names[k % len(names)]
+        boxes = [random_box(rng, str(rng.choice(BOX_KINDS))) for _ in range(2 if name in BINARY else 1)]
+        violations = enclosure_violations(name, boxes, rng)
+        examples += violations[:1]
+        outcomes.append(("refuted" if violations else "proved", not violations))  # an unsound bound counts once
+    return _tally(outcomes, time.perf_counter() - started, examples[:5])
+
+
+def region_kind(count: int) -> dict:
+    started, outcomes, examples = time.perf_counter(), [], []
+    for case in region_cases(count, seed=101):
+        certificate = region_decrease(case.name, *case.arguments(), max_boxes=20_000)
+        holds = case.holds
+        if certificate.status == "refuted" and not case.W(list(certificate.counterexample["x"].values())) > 0:
+            holds = True  # a counterexample that does not violate the claim is unsound whatever the truth
+        outcomes.append((certificate.status, holds))
+        if (certificate.status == "proved") != holds and certificate.status in ("proved", "refuted"):
+            examples.append(f"{case.name}: {certificate.status}, holds {case.holds}")
+    return _tally(outcomes, time.perf_counter() - started, examples[:5])
+
+
+def linear_kind(count: int) -> dict:
+    started, outcomes, examples = time.perf_counter(), [], []
+    for case in linear_cases(count, seed=102):
+        for status, holds in ((lyapunov_decrease(case.name, [case.A], case.gamma, "generated").status, case.holds),
+                              (discrete_lyapunov_decrease(case.name, case.A, case.rho, "generated").status,
+                               case.holds_discrete)):
+            outcomes.append((status, holds))
+            if (status == "proved" and not holds) or (status == "refuted" and holds):
+                examples.append(f"{case.name}: {status}, holds {holds}")
+    return _tally(outcomes, time.perf_counter() - started, examples[:5])
+
+
+def identity_kind(count: int) -> dict:
+    started, outcomes, examples = time.perf_counter(), [], []
+    for case in identity_cases(count, seed=103):
+        status = prove_identity(case.kind, case.lhs, case.rhs, case.inputs, "all x", symbolic_seconds=1.0).status
+        outcomes.append((status, case.holds))
+        if (status == "proved" and not case.holds) or (status == "refuted" and case.holds):
+            examples.append(f"{case.kind}: {status}")
+    result = _tally(outcomes, time.perf_counter() - started, examples[:5])
+    result["by_class"] = {kind: {s: sum(1 for c, (st, _) in zip(identity_cases(count, seed=103), outcomes)
+                                        if c.kind == kind and st == s) for s in result["statuses"]}
+                          for kind in ("relative", "far", "spot", "masked", "cancelling")}
+    return result
+
+
+def main(count: int = 1000) -> dict:
+    kinds = {"interval": interval_kind(count, np.random.default_rng(100))}
+    print(f"interval: {kinds['interval']['cases']} cases, {kinds['interval']['unsound']} unsound", flush=True)
+    for name, run in (("region", region_kind), ("linear", linear_kind), ("identity", identity_kind)):
+        kinds[name] = run(count)
+        print(f"{name}: {kinds[name]['cases']} cases, {kinds[name]['unsound']} unsound, inconclusive rate "
+              f"{kinds[name]['inconclusive_rate']:.3f}, {kinds[name]['seconds']} s", flush=True)
+    claims = [kinds[k] for k in ("region", "linear", "identity")]
+    results = {"cases": sum(k["cases"] for k in kinds.values()), "unsound": sum(k["unsound"] for k in kinds.values()),
+               "inconclusive_rate": sum(k["statuses"].get("inconclusive", 0) for k in claims)
+               / sum(k["cases"] for k in claims),
+               "generated_per_kind": count, "kinds": kinds}
+    return finish(results, {"unsound_max": 0, "generated_per_kind_min": 1000}, RESULTS)
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1000)
