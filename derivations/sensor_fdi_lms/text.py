@@ -150,12 +150,12 @@ not need a trained filter (a step in the measurement is a step in $e$).
 
 ## Beyond the paper: detection over thresholds and noise seeds
 
-{study['seeds']} runs with a +{study['size_deg']:g} deg compass fault at sample {D.FAULT_SAMPLE} and {study['seeds']} runs with a
-one-sample +{study['size_deg']:g} deg disturbance there, each with its own noise seed, without FTC. A fault run is
-detected when the detector fires within {study['within_samples']} samples of the onset; a disturbance run with
-any firing in its record is a false alarm. Thresholds: $\\varepsilon_0$ from 0.25 to 400 deg^2 ($\\varepsilon^2$
-alone), $r_0$ from {study['r0_grid'][0]:g} to {study['r0_grid'][-1]:g} ($R$ alone, and the double criterion at
-$\\varepsilon_0$ = {c['eps0_deg2']:g} deg^2).
+{study['seeds']} runs with a +{study['size_deg']:g} deg compass fault at sample {D.FAULT_SAMPLE} and
+{study['seeds']} runs with a one-sample +{study['size_deg']:g} deg disturbance there, each with its own noise
+seed, without FTC. A fault run is detected when the detector fires within {study['within_samples']} samples of
+the onset; a disturbance run with any firing in its record is a false alarm. Thresholds:
+$\\varepsilon_0$ from 0.25 to 400 deg^2 ($\\varepsilon^2$ alone), $r_0$ from {study['r0_grid'][0]:g} to
+{study['r0_grid'][-1]:g} ($R$ alone, and the double criterion at $\\varepsilon_0$ = {c['eps0_deg2']:g} deg^2).
 
 ![ROC](roc.svg)
 
@@ -172,7 +172,8 @@ At the nominal thresholds:
 The step-size claim takes $P_u$ as the mean square of the healthy run's recorded command and decides
 $\\mu M P_u < 1$ in exact rational arithmetic on the samples' binary values (the mean-square bound of
 independence theory, Widrow & Stearns 1985, $\\operatorname{{tr}} R_{{UU}} = M P_u$). The negative control
-$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted: {negative['claim']}, exact $\\mu M P_u$ = {r['negative_factor']:g}.
+$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted ({negative['claim']}): exact
+$\\mu M P_u$ = {r['negative_factor']:g}.
 `uvsym simulate` warns (`StepSizeWarning`, with the bound) when a scenario's $\\mu$ is at or beyond the
 bound of its own run.
 

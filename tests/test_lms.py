@@ -1,0 +1,206 @@
+"""The LMS-FIR monitor, its double criterion and the step-size claim, against independent oracles."""
+
+from __future__ import annotations
+
+import warnings
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from uvsym.codegen import find_compiler
+from uvsym.codegen.estimators import exported_observer
+from uvsym.codegen.observer_sets import ObserverSet
+from uvsym.errors import ObserverError, StepSizeWarning, VerificationError
+from uvsym.observers.lms import check_mu, lms_monitor, mu_bound
+from uvsym.observers.lms_supervisor import SubstitutionSupervisor, double_criterion
+from uvsym.systems.signals import signals
+from uvsym.verify.lms import lms_step_claim
+
+Y = signals(("y", "m", "sensor"), group="output")
+U = signals(("u", "-", "input"), group="input")
+REF = signals(("r", "m", "reference"), group="input")
+
+
+def monitor(M=4, mu=0.01, window=5, hold=1, confirm=3, eps0=1.0, r0=2.0, reference=None):
+    return lms_monitor(Y, U, order=M, mu=mu, eps0=eps0, r0=r0, dt=0.1, window=window, hold=hold, confirm=confirm,
+                       reference=reference)
+
+
+def regressors(u: np.ndarray, M: int) -> np.ndarray:
+    """(N, M) rows [u_{k-1}, ..., u_{k-M}] (zeros before the start)."""
+    padded = np.concatenate([np.zeros(M), u])
+    return np.array([padded[k:k + M][::-1] for k in range(len(u))])
+
+
+def test_lms_identifies_a_known_fir_filter():
+    rng = np.random.default_rng(0)
+    M, N = 4, 3000
+    true = np.array([0.5, -0.3, 0.2, 0.1])
+    u = rng.uniform(-1, 1, N)
+    y = regressors(u, M) @ true
+    obs = monitor(M=M, mu=0.05, eps0=1e6, r0=1e6)
+    S, OUT = obs.run(y[:, None], u[:, None])
+    np.testing.assert_allclose(S[-1, :M], true, atol=1e-6)  # the weights are the state's first M entries
+    assert np.abs(OUT[-100:, obs.publishes.index("e_y")]).max() < 1e-6
+
+
+def test_one_step_is_the_descending_lms_update_with_a_reference():
+    rng = np.random.default_rng(1)
+    M = 3
+    obs = monitor(M=M, mu=0.02, reference=REF, window=4)
+    s = obs.initial_state([0.0], [0.0, 0.0])
+    C, hist = rng.normal(size=M), rng.normal(size=M)
+    s[:M], s[M:2 * M] = C, hist
+    y, u, r = 1.3, 0.4, 0.9
+    s_next, out = (np.asarray(v).ravel() for v in obs.step(s, y, [u, r], obs.p0))
+    d = C @ hist
+    e = d - (y - r)
+    np.testing.assert_allclose(s_next[:M], C - 2 * 0.02 * e * hist, rtol=1e-14)
+    np.testing.assert_allclose(s_next[M:2 * M], [u, hist[0], hist[1]])
+    names = obs.publishes.names
+    assert out[names.index("y_fir")] == pytest.approx(r + d) and out[names.index("e_y")] == pytest.approx(e)
+    assert out[names.index("eps2_y")] == pytest.approx(e ** 2)
+
+
+def test_R_is_the_squared_z_score_of_the_newest_weight_sum_in_its_window():
+    rng = np.random.default_rng(2)
+    M, n, N = 3, 6, 80
+    obs = monitor(M=M, mu=0.1, window=n, eps0=1e6, r0=1e6)
+    u, y = rng.normal(size=N), rng.normal(size=N)
+    S, OUT = obs.run(y[:, None], u[:, None])
+    sums = S[:-1, :M].sum(axis=1)  # sum of the weights in use at each sample
+    R = OUT[:, obs.publishes.index("R_y")]
+    assert np.all(R[:n - 1] == 0.0)  # not before the window is full
+    for k in range(n - 1, N):
+        window = sums[k - n + 1:k + 1]
+        assert R[k] == pytest.approx((window[-1] - window.mean()) ** 2 / window.var(), rel=1e-9)
+
+
+def test_a_single_large_error_gives_R_exactly_n_minus_1_and_hold_filters_it():
+    M, n, spike = 2, 8, 25
+    true = np.array([0.5, -0.25])
+    u = np.array([1.0, 2.0, -1.0, 0.0, 3.0] * 8)  # dyadic values: the healthy error is exactly 0
+    y = regressors(u, M) @ true
+    y[spike] += 5.0
+    for hold, fires in ((1, True), (2, False)):
+        obs = monitor(M=M, mu=0.01, window=n, hold=hold, eps0=1.0, r0=n - 1.5)
+        s0 = obs.initial_state([0.0], [0.0])
+        s0[:M] = true
+        _, OUT = obs.run(y[:, None], u[:, None], s0=s0)
+        R = OUT[:, obs.publishes.index("R_y")]
+        assert R[spike + 1] == pytest.approx(n - 1, rel=1e-9)  # closed form: one outlier among n
+        assert np.all(R[:spike + 1] == 0.0)  # constant weights: no spread, no statistic
+        assert bool(OUT[:, obs.publishes.index("alarm_R_y")].any()) is fires
+        assert OUT[spike, obs.publishes.index("alarm_eps2_y")] == 1.0
+
+
+def decide_sequence(a_e, a_r, confirm=3):
+    decide = double_criterion(confirm)
+    d, rows = np.zeros(3), []
+    for e, r in zip(a_e, a_r):
+        d_next, snapshot, released = (np.asarray(v).ravel() for v in decide(d, e, r))
+        rows.append((*d_next, snapshot[0], released[0]))
+        d = d_next
+    return np.array(rows)  # frozen, age, fault, snapshot, released
+
+
+def test_double_criterion_confirms_a_fault_only_when_R_fires_within_the_window():
+    zeros = [0] * 10
+    both = decide_sequence([0, 1, 1, 1, 1, 1, 0, 0, 0, 0], [0, 0, 0, 1, 0, 0, 0, 0, 0, 0])
+    assert list(both[:, 3]) == [0, 1] + [0] * 8  # one snapshot, at the first eps2 alarm
+    assert list(both[:, 2]) == [0, 0, 0, 1, 1, 1, 1, 1, 1, 1]  # confirmed when R fires, then latched
+    only_eps = decide_sequence([0, 1, 0, 0, 0, 0, 1, 0, 0, 0], zeros)
+    assert list(only_eps[:, 4]) == [0, 0, 0, 0, 1, 0, 0, 0, 0, 1]  # released confirm = 3 samples after each
+    assert list(only_eps[:, 0]) == [0, 1, 1, 1, 0, 0, 1, 1, 1, 0]  # and frozen anew by the next alarm
+    assert not only_eps[:, 2].any()
+    only_r = decide_sequence(zeros, [0, 1, 1, 1, 0, 0, 0, 0, 0, 0])
+    assert not only_r[:, [0, 2, 3]].any()
+    late = decide_sequence([0, 1] + [0] * 8, [0] * 5 + [1] + [0] * 4)
+    assert not late[:, 2].any()
+
+
+def test_frozen_filter_predicts_with_the_weights_of_the_alarm_sample():
+    rng = np.random.default_rng(3)
+    M, N, onset = 3, 60, 40
+    u = rng.uniform(-1, 1, N)
+    y = regressors(u, M) @ np.array([0.3, 0.2, -0.1]) + 0.01 * rng.normal(size=N)
+    y[onset:] += 2.0
+    obs = monitor(M=M, mu=0.2, eps0=0.5, r0=1e6, confirm=100)
+    S, OUT = obs.run(y[:, None], u[:, None])
+    names = obs.publishes.names
+    assert np.flatnonzero(OUT[:, names.index("alarm_eps2_y")])[0] == onset
+    frozen = S[onset, :M]  # weights in use at the alarm sample, before its update
+    expected = regressors(u, M)[onset:] @ frozen
+    np.testing.assert_allclose(OUT[onset:, names.index("y_sub")], expected, rtol=1e-12)
+    assert not np.allclose(S[-1, :M], frozen)  # the live filter kept learning
+
+
+@pytest.mark.parametrize("argument, kwargs", [
+    ("order M", {"M": 0}), ("mu", {"mu": 0.0}), ("mu", {"mu": -1.0}), ("eps0", {"eps0": 0.0}), ("r0", {"r0": -2.0}),
+    ("window n", {"window": 1}), ("hold", {"hold": 0}), ("confirm", {"confirm": 0}), ("order M", {"M": 2.5})])
+def test_bad_settings_are_typed_errors_naming_the_argument(argument, kwargs):
+    with pytest.raises(ObserverError, match=argument):
+        monitor(**kwargs)
+
+
+def test_step_size_bound_and_warning():
+    assert mu_bound(70, 0.25) == pytest.approx(1 / 17.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_mu(0.05, 70, 0.25)  # below 1/17.5: silent
+    with pytest.warns(StepSizeWarning, match=r"bound 1 / \(M P_u\) = 0.05714"):
+        check_mu(0.06, 70, 0.25)
+    with pytest.raises(ObserverError, match="input power"):
+        mu_bound(70, 0.0)
+
+
+def test_step_claim_decides_the_inequality_exactly():
+    u = np.array([1.0, 1.0, 1.0, 1.0])  # P_u = 1 exactly
+    at_bound = lms_step_claim(0.25, 4, u, expected="refuted")  # mu M P_u = 1 exactly: not below
+    assert at_bound.status == "refuted" and at_bound.details["mu_M_P_u"] == 1.0
+    below = lms_step_claim(0.1, 3, np.array([0.1, -0.3, 0.2]))
+    power = (Fraction(0.1) ** 2 + Fraction(-0.3) ** 2 + Fraction(0.2) ** 2) / 3
+    assert below.status == "proved" and below.margin == pytest.approx(float(1 - Fraction(0.1) * 3 * power))
+    with pytest.raises(VerificationError, match="mu"):
+        lms_step_claim(-1.0, 3, u)
+    with pytest.raises(VerificationError, match="input samples"):
+        lms_step_claim(0.1, 3, np.array([np.nan]))
+
+
+def test_beyond_the_bound_the_filter_diverges_below_it_converges():
+    rng = np.random.default_rng(4)
+    M, N = 8, 400
+    u = rng.uniform(-1, 1, N)
+    y = regressors(u, M) @ rng.normal(size=M)
+    bound = mu_bound(M, float(np.mean(u ** 2)))
+    sizes = {}
+    for factor in (0.1, 2.0):
+        S, _ = monitor(M=M, mu=factor * bound, eps0=1e300, r0=1e6).run(y[:, None], u[:, None])
+        sizes[factor] = np.abs(S[-1, :M]).max()
+    assert sizes[0.1] < 10 and sizes[2.0] > 1e6
+
+
+def test_supervisor_substitutes_once_confirmed_and_logs():
+    obs = monitor(M=2)
+    names = obs.publishes.names
+    flags = np.zeros((6, len(names)))
+    flags[2:, names.index("frozen_y")] = 1
+    flags[4:, names.index("fault_y")] = 1
+    supervisor = SubstitutionSupervisor(obs)
+    decision = supervisor.update(np.arange(6) * 0.1, {obs.name: flags})
+    assert decision.channels == frozenset({"y"})
+    assert [e.sample for e in supervisor.events[:2]] == [2, 4]
+    with pytest.raises(ObserverError, match="substitute_on"):
+        SubstitutionSupervisor(obs, substitute_on="never")
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+def test_generated_c_of_the_monitor_matches_python(tmp_path):
+    from uvsym.codegen.check import check_package
+
+    obs = monitor(M=5, reference=REF)
+    exported = (exported_observer(obs),)
+    ObserverSet("uvsym_lms_test", "LMS monitor", exported).write(tmp_path)
+    check = check_package(tmp_path, list(exported), "uvsym_lms_test")
+    assert check.max_relative_difference <= 1e-12
