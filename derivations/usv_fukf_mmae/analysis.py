@@ -38,7 +38,7 @@ def bank_figures(t: np.ndarray, bank, scenario: Scenario) -> dict:
     figures = {"p_nofault_min_outside_windows": float(np.min(bank["p_nofault"][outside])), "faults": []}
     for f in scenario.faults:
         side = SIDE[f.thruster]
-        last = (t >= f.end - LAST - 1e-9) & (t < f.end - 1e-9)
+        last = (t >= max(f.onset, f.end - LAST) - 1e-9) & (t < f.end - 1e-9)  # a short window: all of it
         estimate = float(np.mean(bank[f"{side}.alpha_{f.thruster}_hat"][last]))
         figures["faults"].append({"thruster": f.thruster, "model": side, "onset_s": f.onset, "end_s": f.end,
                                   "efficiency": f.efficiency,

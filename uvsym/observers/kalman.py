@@ -207,10 +207,10 @@ def covariance_signals(x: Signals) -> Signals:
 def measurement_gate(filt: GaussianFilter, x, P, y, u, p):
     """The update of ``filt`` with NaN measurements gated out (module docstring):
     (x_post, P_post, r, loglik, margin, skipped) as SX."""
-    valid = ca.SX(1.0)
-    for i in range(y.numel()):
-        valid = valid * (y[i] == y[i])
     y_clean = ca.fmin(ca.fmax(y, -FINITE), FINITE)  # fmax/fmin drop NaN: the graph stays finite
+    valid = ca.SX(1.0)
+    for i in range(y.numel()):  # NaN == anything is false (y == y would be simplified away)
+        valid = valid * (y_clean[i] == y[i])
     y_used = valid * y_clean + (1.0 - valid) * filt.system.h(x, u, p)
     x_post, P_post, r, loglik, margin = filt.update(x, P, y_used, u, p)
     return (ca.if_else(valid, x_post, x), ca.if_else(valid, P_post, P), valid * r, valid * loglik, margin,

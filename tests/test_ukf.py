@@ -1,0 +1,162 @@
+"""The UKF: exactly the Kalman filter on a linear Gaussian system, consistent (NEES) on the Otter,
+and typed errors for bad input."""
+
+import casadi as ca
+import numpy as np
+import pytest
+from scipy.stats import chi2, multivariate_normal
+
+import uvsym
+from uvsym.errors import CovarianceError, ObserverError
+from uvsym.observers.kalman import run_filter, transition, unpacked
+from uvsym.observers.ukf import passive_last, ukf, unscented_weights
+from uvsym.systems.signals import signals
+from uvsym.systems.system import system
+
+A = np.array([[1.0, 0.1, 0.0], [-0.2, 0.9, 0.05], [0.0, 0.1, 0.95]])
+B = np.array([[0.0], [0.1], [0.3]])
+C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+Q = np.diag([0.01, 0.02, 0.005])
+R = np.array([[0.1, 0.02], [0.02, 0.2]])
+P0 = 2.0 * np.eye(3)
+X0 = np.array([1.0, -1.0, 0.5])
+
+
+def linear_plant():
+    x = signals(("a", "m"), ("b", "m/s"), ("c", "-"), group="state")
+    return system("linear", "x+ = A x + B u, y = C x", x=x, u=signals(("f", "N"), group="input"),
+                  rhs=lambda x, u, d, p: ca.mtimes(ca.DM(A), x) + ca.mtimes(ca.DM(B), u),
+                  y=signals(("a_m", "m"), ("c_m", "-"), group="output"),
+                  output=lambda x, u, p: ca.mtimes(ca.DM(C), x), dt=0.1)
+
+
+def kalman_filter(Y, U):
+    """Textbook Kalman filter (numpy): posteriors, priors' covariances and log-likelihoods."""
+    x, P = X0.copy(), P0.copy()
+    posts, priors, logliks = [], [], []
+    for y, u in zip(Y, U):
+        priors.append(P.copy())
+        S = C @ P @ C.T + R
+        K = P @ C.T @ np.linalg.inv(S)
+        logliks.append(multivariate_normal(C @ x, S).logpdf(y))
+        x, P = x + K @ (y - C @ x), P - K @ S @ K.T
+        posts.append(x.copy())
+        x, P = A @ x + B @ u, A @ P @ A.T + Q
+    return np.array(posts), priors, np.array(logliks)
+
+
+@pytest.fixture(scope="module")
+def data():
+    rng = np.random.default_rng(0)
+    return rng.normal(size=(150, 2)), rng.normal(size=(150, 1))
+
+
+@pytest.mark.parametrize("alpha, beta, kappa", [(1.0, 2.0, 0.0), (0.5, 2.0, 1.0), (0.1, 0.0, 0.0)])
+def test_ukf_is_the_kalman_filter_on_a_linear_gaussian_system(data, alpha, beta, kappa):
+    Y, U = data
+    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, x0=X0, alpha=alpha, beta=beta, kappa=kappa)
+    S, OUT = run_filter(obs, Y, U)
+    posts, priors, logliks = kalman_filter(Y, U)
+    np.testing.assert_allclose(OUT[:, :3], posts, rtol=0, atol=1e-10)
+    for k in (0, 1, 50, 149):
+        np.testing.assert_allclose(unpacked(S[k, 3:], 3), priors[k], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(OUT[:, obs.publishes.index("loglik")], logliks, rtol=1e-9, atol=0)
+    assert np.all(OUT[:, obs.publishes.index("pd_margin")] > 0) and not OUT[:, -1].any()
+
+
+def test_weights_are_the_scaled_unscented_transform():
+    n, alpha, beta, kappa = 7, 0.3, 2.0, 1.0
+    lam = alpha**2 * (n + kappa) - n
+    scale, w_m, w_c = unscented_weights(n, alpha, beta, kappa)
+    assert scale == pytest.approx(np.sqrt(n + lam))
+    assert w_m.sum() == pytest.approx(1.0) and w_m[0] == pytest.approx(lam / (n + lam))
+    assert w_c[0] == pytest.approx(lam / (n + lam) + 1 - alpha**2 + beta)
+    np.testing.assert_allclose(w_m[1:], 1 / (2 * (n + lam)))
+
+
+def test_positions_go_last_in_the_square_root_order():
+    otter = uvsym.plant("otter3dof")
+    order = passive_last(otter, lambda x, u, p: otter.f(x, u, [], p))
+    assert [otter.x.names[i] for i in order[-2:]] == ["x", "y"]
+
+
+@pytest.mark.parametrize("alpha", [0.0, -0.5, 1.5, float("nan")])
+def test_alpha_outside_the_unit_interval_is_refused(alpha):
+    with pytest.raises(ObserverError, match="alpha"):
+        ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, alpha=alpha)
+
+
+@pytest.mark.parametrize("argument, value", [("P0", np.diag([1.0, -1.0, 1.0])), ("Q", np.zeros((3, 3))),
+                                             ("R", np.array([[1.0, 2.0], [2.0, 1.0]])),
+                                             ("R", np.array([[1.0, 0.5], [0.0, 1.0]])), ("Q", np.eye(2))])
+def test_covariances_that_are_not_positive_definite_are_refused(argument, value):
+    options = {"Q": Q, "R": R, "P0": P0, argument: value}
+    with pytest.raises(CovarianceError, match=argument):
+        ukf(linear_plant(), dt=0.1, **options)
+
+
+def test_measurements_of_the_wrong_size_are_refused(data):
+    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
+    with pytest.raises(ObserverError, match=r"measurements Y must be \(N, 2\)"):
+        run_filter(obs, np.zeros((5, 3)), np.zeros((5, 1)))
+
+
+def test_a_nan_measurement_skips_the_update_and_says_so(data):
+    Y, U = data
+    Y = Y[:20].copy()
+    Y[7, 1] = np.nan
+    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, x0=X0)
+    S, OUT = run_filter(obs, Y, U[:20])
+    assert OUT[:, obs.publishes.index("skipped")].tolist() == [float(k == 7) for k in range(20)]
+    np.testing.assert_allclose(OUT[7, :3], S[7, :3], atol=1e-14)  # posterior = prior
+    np.testing.assert_allclose(S[8, :3], A @ S[7, :3] + B @ U[7], atol=1e-12)  # prediction made
+    assert OUT[7, obs.publishes.index("loglik")] == 0.0 and np.all(np.isfinite(OUT))
+
+
+def test_a_covariance_that_is_no_longer_positive_definite_raises_naming_the_sample(data):
+    Y, U = data
+    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
+    s0 = np.concatenate([X0, [1.0, 2.0, 0.0, 1.0, 0.0, 1.0]])  # tril of [[1, 2, 0], [2, 1, 0], [0, 0, 1]]
+    with pytest.raises(CovarianceError, match=r"sample 0 \(t = 0 s"):
+        run_filter(obs, Y[:5], U[:5], s0=s0)
+    out = obs.step(s0, Y[0], U[0], [])[1]  # and the step itself stays finite
+    assert np.all(np.isfinite(np.asarray(out)))
+
+
+def test_nees_of_the_otter_ukf_is_within_its_chi_square_bounds():
+    """Monte Carlo: 40 runs of 150 samples of the Otter driven with the filter's own Q and R;
+    the average NEES over runs at each sample lies within its 99 % chi-square band (Bar-Shalom's
+    test) at >= 95 % of the samples, and the overall average within 10 % of the state size."""
+    otter, dt, runs, steps = uvsym.plant("otter3dof"), 0.05, 40, 150
+    q = np.array([1e-4, 1e-4, 1e-5, 1e-4, 1e-4, 1e-5])
+    r = np.array([0.05, 0.05, 0.0035, 0.02, 0.02, 0.0035]) ** 2
+    p0 = np.array([0.5, 0.5, 0.05, 0.1, 0.1, 0.05]) ** 2
+    obs = ukf(otter, dt=dt, Q=q, R=r, P0=p0, x0=[0, 0, 0, 1.5, 0, 0])
+    x, u, p = ca.SX.sym("x", 6), ca.SX.sym("u", 2), ca.SX.sym("p", 2)
+    step = ca.Function("F", [x, u, p], [transition(otter, dt)(x, u, p)])
+    rng = np.random.default_rng(7)
+    wave = 10 * np.sin(0.3 * dt * np.arange(steps))
+    U = np.column_stack([58 + wave, 58 - wave])
+    nees = np.empty((runs, steps))
+    for k in range(runs):
+        xk = np.array([0, 0, 0, 1.5, 0, 0]) + np.sqrt(p0) * rng.standard_normal(6)
+        X, Y = [], []
+        for i in range(steps):
+            X.append(xk)
+            Y.append(xk + np.sqrt(r) * rng.standard_normal(6))
+            xk = np.asarray(step(xk, U[i], [0, 0])).ravel() + np.sqrt(q) * rng.standard_normal(6)
+        S, OUT = run_filter(obs, np.array(Y), U)
+        for i in range(steps):
+            e = np.array(X[i]) - OUT[i, :6]
+            nees[k, i] = e @ np.linalg.solve(_posterior(S[i], np.diag(r)), e)
+    low, high = chi2.ppf([0.005, 0.995], runs * 6) / runs
+    inside = np.mean((nees.mean(axis=0) > low) & (nees.mean(axis=0) < high))
+    assert inside >= 0.95
+    assert abs(nees.mean() / 6 - 1) < 0.1
+
+
+def _posterior(s, R):
+    """P_{k|k} from the prior P_{k|k-1} held in the state s: with y = x the update is linear, and
+    the UKF's equals the closed form ``P - P (P + R)^-1 P``."""
+    P = unpacked(s[6:], 6)
+    return P - P @ np.linalg.solve(P + R, P)
