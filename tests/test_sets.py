@@ -134,3 +134,18 @@ def test_growing_enclosure_is_an_error_not_a_long_run():
         propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 5, 2, growth_limit=0.5)
     with pytest.raises(SetError, match="dimension 2"):
         propagate(np.eye(2) * 0.5, np.eye(2), box([-1.0], [1.0]), box([-1, -1], [1, 1]), 5, 4)
+
+
+@pytest.mark.parametrize("method", ["girard", "combastel"])
+def test_compiled_box_reduction_equals_the_numpy_path(method, monkeypatch):
+    from uvsym.sets import kernel, reduction
+
+    if kernel.box_reduce(np.eye(2), 2, False) is None:
+        pytest.skip("no C compiler: only the numpy path exists")
+    Z = _random_zonotope(11, 6, 200)
+    compiled = reduce(Z, 30, method)
+    monkeypatch.setattr(reduction, "box_reduce", lambda *args, **kwargs: None)
+    reference = reduce(Z, 30, method)
+    np.testing.assert_allclose(compiled.zonotope.generators, reference.zonotope.generators, rtol=1e-14)
+    np.testing.assert_allclose(compiled.coefficients, reference.coefficients, rtol=1e-14)
+    assert reduce(Z, 30, method, coefficients=False).coefficients is None

@@ -7,7 +7,7 @@
 - uvsym's set-up (all eight states measured): each bank observer's conditions hold and its
   designed gain makes ``F`` Schur stable, proved in exact rationals;
 - the bands enclose the healthy residuals: Monte Carlo over the healthy runs (numerical
-  evidence, so "inconclusive" is the best it can be; a violation confirmed by LP refutes it).
+  evidence: status "checked", never "proved"; a violation confirmed by LP refutes it).
 
 The plant matrices are the exact zero-order hold (finite series: the hover model is a chain of
 integrators) of the CasADi linearisation, whose double entries are taken as exact rationals.
@@ -84,8 +84,8 @@ def enclosure_claim(report: dict | None = None) -> Certificate:
     method = (f"Monte Carlo: witness coefficients carried through every reduction, {report['lp_checked']} samples "
               "re-checked by LP (numerical evidence, not a proof)")
     if report["violations"]:
-        return Certificate(claim, where, method, "refuted", "inconclusive", seconds=time.perf_counter() - started,
+        return Certificate(claim, where, method, "refuted", "checked", seconds=time.perf_counter() - started,
                            counterexample=report["first_violation"])
-    return Certificate(claim, where, method, "inconclusive", "inconclusive", margin=1 - report["worst_coefficient"],
+    return Certificate(claim, where, method, "checked", "checked", margin=1 - report["worst_coefficient"],
                        seconds=time.perf_counter() - started,
                        reason=f"0 of {report['samples']} samples outside: evidence, not a proof", details=report)

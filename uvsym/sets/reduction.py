@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvsym.errors import SetError
+from uvsym.sets.kernel import box_reduce
 from uvsym.sets.zonotope import Zonotope
 
 __all__ = ["METHODS", "Reduction", "reduce"]
@@ -33,23 +34,15 @@ METHODS = ("girard", "combastel", "pca")
 @dataclass(frozen=True)
 class Reduction:
     """zonotope: the reduced zonotope (n, <= generators); coefficients: R (m_new, m_old) with
-    ``G_old = G_new R`` and every row's absolute sum <= 1."""
+    ``G_old = G_new R`` and every row's absolute sum <= 1 (None when not asked for)."""
 
     zonotope: Zonotope
-    coefficients: np.ndarray
+    coefficients: np.ndarray | None
 
 
-def _group(G: np.ndarray, count: int, method: str) -> np.ndarray:
-    """Indices of the ``count`` generators the method replaces."""
-    if method == "combastel":
-        score = np.linalg.norm(G, axis=0)
-    else:
-        score = np.sum(np.abs(G), axis=0) - np.max(np.abs(G), axis=0)
-    return np.sort(np.argsort(score, kind="stable")[:count])
-
-
-def reduce(zonotope: Zonotope, generators: int, method: str = "girard") -> Reduction:
-    """The zonotope with at most ``generators`` generators enclosing ``zonotope`` (module docstring).
+def reduce(zonotope: Zonotope, generators: int, method: str = "girard", coefficients: bool = True) -> Reduction:
+    """The zonotope with at most ``generators`` generators enclosing ``zonotope`` (module docstring);
+    with ``coefficients=False`` the map R is not formed (``Reduction.coefficients`` is None).
 
     Raises
     ------
@@ -60,21 +53,45 @@ def reduce(zonotope: Zonotope, generators: int, method: str = "girard") -> Reduc
     if method not in METHODS:
         raise SetError(f"unknown reduction method {method!r}; known: {', '.join(METHODS)}")
     n, m = zonotope.dimension, zonotope.order
-    if isinstance(generators, bool) or not isinstance(generators, numbers.Integral) or generators < n:
+    if type(generators) is not int and (isinstance(generators, bool) or not isinstance(generators, numbers.Integral)) \
+            or generators < n:
         raise SetError(f"reduction order: generators must be an integer >= the dimension {n} (a parallelotope), "
                        f"got {generators!r}")
     if m <= generators:
-        return Reduction(zonotope, np.eye(m))
+        return Reduction(zonotope, np.eye(m) if coefficients else None)
     G = zonotope.generators
-    replaced = _group(G, m - generators + n, method)
-    kept = np.setdiff1d(np.arange(m), replaced)
+    count = m - generators + n  # replaced by n parallelotope generators
+    if method != "pca":
+        compiled = box_reduce(G, count, method == "combastel", details=coefficients)
+        if compiled is not None:
+            new_G, replaced, s = compiled
+            reduced = Zonotope.trusted(zonotope.center, new_G)
+            return Reduction(reduced, _coefficients(replaced, G[:, replaced], s) if coefficients else None)
+    if method == "combastel":
+        score = np.einsum("ij,ij->j", G, G)
+    else:
+        magnitude = np.abs(G)
+        score = magnitude.sum(axis=0) - magnitude.max(axis=0)
+    replaced = np.zeros(m, dtype=bool)
+    replaced[np.argsort(score, kind="stable")[:count]] = True  # ties to the lower index, as the C kernel
     G_s = G[:, replaced]
-    U = np.linalg.svd(G_s, full_matrices=True)[0] if method == "pca" else np.eye(n)
-    rotated = U.T @ G_s
+    U = np.linalg.svd(G_s, full_matrices=False)[0] if method == "pca" else None
+    rotated = G_s if U is None else U.T @ G_s
     s = np.sum(np.abs(rotated), axis=1)
     axes = np.flatnonzero(s > 0)
-    B = U[:, axes] * s[axes]
-    R = np.zeros((kept.size + axes.size, m))
+    if U is None:
+        B = np.zeros((n, axes.size))
+        B[axes, np.arange(axes.size)] = s[axes]
+    else:
+        B = U[:, axes] * s[axes]
+    reduced = Zonotope.trusted(zonotope.center, np.hstack([G[:, ~replaced], B]))
+    return Reduction(reduced, _coefficients(replaced, rotated, s) if coefficients else None)
+
+
+def _coefficients(replaced: np.ndarray, rotated: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """R (module docstring) from the replaced mask (m,), ``U^T G_s`` and its absolute row sums s."""
+    kept, axes = np.flatnonzero(~replaced), np.flatnonzero(s > 0)
+    R = np.zeros((kept.size + axes.size, replaced.size))
     R[np.arange(kept.size), kept] = 1.0
-    R[np.ix_(kept.size + np.arange(axes.size), replaced)] = rotated[axes] / s[axes, None]
-    return Reduction(Zonotope(zonotope.center, np.hstack([G[:, kept], B])), R)
+    R[np.ix_(kept.size + np.arange(axes.size), np.flatnonzero(replaced))] = rotated[axes] / s[axes, None]
+    return R

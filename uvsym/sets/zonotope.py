@@ -60,6 +60,15 @@ class Zonotope:
             value.setflags(write=False)
             object.__setattr__(self, name, value)
 
+    @classmethod
+    def trusted(cls, center: np.ndarray, generators: np.ndarray) -> Zonotope:
+        """A zonotope from arrays already known to be finite and conforming (results of operations
+        on checked zonotopes), without re-checking them."""
+        zonotope = object.__new__(cls)
+        object.__setattr__(zonotope, "center", center)
+        object.__setattr__(zonotope, "generators", generators)
+        return zonotope
+
     @property
     def dimension(self) -> int:
         """n."""
@@ -74,7 +83,7 @@ class Zonotope:
         """``M Z + b``: M (k, n), b (k,) or None."""
         M = finite_matrix(M, "map matrix", (None, self.dimension))
         b = np.zeros(M.shape[0]) if b is None else finite_matrix(b, "map offset", (M.shape[0],))
-        return Zonotope(M @ self.center + b, M @ self.generators)
+        return Zonotope.trusted(M @ self.center + b, M @ self.generators)
 
     def __add__(self, other: Zonotope) -> Zonotope:
         """Minkowski sum with another zonotope of the same dimension (independent generators)."""
@@ -82,7 +91,7 @@ class Zonotope:
             return NotImplemented
         if other.dimension != self.dimension:
             raise SetError(f"Minkowski sum of zonotopes of dimensions {self.dimension} and {other.dimension}")
-        return Zonotope(self.center + other.center, np.hstack([self.generators, other.generators]))
+        return Zonotope.trusted(self.center + other.center, np.hstack([self.generators, other.generators]))
 
     def interval_hull(self) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper), each (n,): the smallest box holding the zonotope."""
