@@ -39,6 +39,9 @@ class CheckedFunction(ca.Function):
         raw = raw.raw if isinstance(raw, CheckedFunction) else raw
         ca.Function.__init__(self, raw)
         self._raw, self._owner, self._labels, self._guard = raw, owner, dict(labels or {}), guard
+        self._names = list(raw.name_in())
+        self._outputs = list(raw.name_out())
+        self._shapes = {name: (raw.size1_in(i), raw.size2_in(i)) for i, name in enumerate(self._names)}
 
     @property
     def raw(self) -> ca.Function:
@@ -58,7 +61,7 @@ class CheckedFunction(ca.Function):
         return f"{self._owner}.{self._raw.name()}"
 
     def __call__(self, *args, **kwargs):
-        names = list(self._raw.name_in())
+        names = self._names
         if args and kwargs:
             raise ArgumentError(f"{self._where()}: give the arguments all by position or all by name "
                                 f"({', '.join(names)})")
@@ -93,15 +96,16 @@ class CheckedFunction(ca.Function):
         return result
 
     def _check_argument(self, name: str, value: np.ndarray) -> None:
-        index = self._raw.index_in(name)
-        expected = self._raw.numel_in(index)
-        shape = (self._raw.size1_in(index), self._raw.size2_in(index))
+        shape = self._shapes[name]
+        expected = shape[0] * shape[1]
         vector = 1 in shape
         fits = value.size == 1 or (value.ndim <= 1 and vector) or value.shape in ((shape, shape[::-1]) if vector else
                                                                               (shape,))
         if value.size not in (expected, 1) or (value.size == 1 and expected == 0) or not fits:
             raise ArgumentError(f"{self._where()}: argument {name} has {value.size} entries (shape "
                                 f"{value.shape}), expected {expected} (shape {shape})")
+        if np.isfinite(value).all():
+            return
         bad = np.flatnonzero(~np.isfinite(value.ravel(order="F")))
         if bad.size:
             raise ArgumentError(f"{self._where()}: argument {name} {self._entry(name, bad[0], expected)} is "
@@ -109,9 +113,11 @@ class CheckedFunction(ca.Function):
 
     def _check_outputs(self, result, values: dict) -> None:
         outputs = result if isinstance(result, dict) else dict(
-            zip(self._raw.name_out(), result if isinstance(result, tuple) else (result,)))
+            zip(self._outputs, result if isinstance(result, tuple) else (result,)))
         for name, value in outputs.items():
-            array = np.asarray(ca.DM(value).full()).ravel(order="F")
+            array = value.full().ravel(order="F")
+            if np.isfinite(array).all():
+                continue
             bad = np.flatnonzero(~np.isfinite(array))
             if bad.size:
                 at = "; ".join(f"{n} = {np.array2string(v.ravel(), precision=6, separator=', ')}"

@@ -10,6 +10,7 @@ with ``h`` the sum of the vehicle's named hull terms (Coriolis, damping, restori
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -241,8 +242,11 @@ def _attitude_guard(name: str):
 
     def guard(values: dict) -> None:
         x = values["x"]
+        phi, theta = x[3:5] if x.size > 4 else (x[0], x[0])
+        if abs(math.cos(theta)) > 1e-6:  # far from it: Tzyx (CasADi on numbers) only decides near it
+            return
         try:
-            Tzyx(*(x[3:5] if x.size > 4 else (x[0], x[0])))
+            Tzyx(phi, theta)
         except KinematicsError as exc:
             raise KinematicsError(f"{name}.f: x entry theta: {exc}") from None
 
