@@ -77,6 +77,9 @@ def test_motor_main_c_prints_what_python_computes(tmp_path):
     assert list(printed) == ["s_next", "out"]
     for values, python in zip(printed.values(), expected):
         np.testing.assert_allclose(values, python, rtol=1e-14)
+    prototypes = re.findall(r"(?m)^int uvsym_induction_motor_\w+\(.*\);$", (tmp_path / "pkg" / "README.md").read_text())
+    header = (tmp_path / "pkg" / "include" / "uvsym_induction_motor.h").read_text()
+    assert prototypes and all(p in header for p in prototypes)  # p[0] is a pointer in both (no zero-size arrays)
     measured = made.example.first_call()[1]  # i_sq, i_sd, omega_m as the noisy sensors read them
     assert np.abs(printed["out"][[0, 1, 4]] - measured).max() < 0.5  # converged estimates near the readings
 

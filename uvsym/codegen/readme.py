@@ -19,8 +19,10 @@ def _argument_rows(function: dict) -> list[str]:
 
 
 def _function_section(function: dict, real: str) -> str:
-    arguments = [f"const {real} {a['name']}[{a['size']}]" for a in function["inputs"]]
-    arguments += [f"{real} {a['name']}[{a['size']}]" for a in function["outputs"]]
+    arguments = [f"const {real} {a['name']}[{a['size']}]" if a["size"] else f"const {real}* {a['name']}"
+                 for a in function["inputs"]]
+    arguments += [f"{real} {a['name']}[{a['size']}]" if a["size"] else f"{real}* {a['name']}"
+                  for a in function["outputs"]]
     table = ["| | argument | size | entries [unit] |", "|---|---|---|---|", *_argument_rows(function)]
     return (f"### `{function['c_function']}`\n\n{function['description']}.\n\n"
             f"```c\nint {function['c_function']}({', '.join(arguments)});\n```\n\n" + "\n".join(table) + "\n")
