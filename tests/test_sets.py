@@ -149,3 +149,11 @@ def test_compiled_box_reduction_equals_the_numpy_path(method, monkeypatch):
     np.testing.assert_allclose(compiled.zonotope.generators, reference.zonotope.generators, rtol=1e-14)
     np.testing.assert_allclose(compiled.coefficients, reference.coefficients, rtol=1e-14)
     assert reduce(Z, 30, method, coefficients=False).coefficients is None
+
+
+def test_untracked_propagation_has_the_same_bands_and_refuses_coefficients():
+    args = ([[0.5, 0.1], [0.0, 0.3]], np.eye(2), box([-1, -1], [1, 1]), box([-0.1, -0.1], [0.1, 0.1]), 20, 4)
+    tracked, untracked = propagate(*args), propagate(*args, track=False)
+    np.testing.assert_array_equal(tracked.upper, untracked.upper)
+    with pytest.raises(SetError, match="track=True"):
+        carry_coefficients(untracked, np.zeros((2, 1)), np.zeros((20, 2, 1)))

@@ -63,10 +63,11 @@ def uio_bank(A, B, C, D, poles, *, states: Signals, outputs: Signals, inputs: Si
 
 
 def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, generators: int,
-                   method: str = "girard", growth_limit: float = 10.0) -> Propagation:
+                   method: str = "girard", growth_limit: float = 10.0, track: bool = True) -> Propagation:
     """Zonotopes of the healthy residual ``r_k``, k = 0 .. steps - 1 (module docstring).
 
-    noise_bound: (p,) vbar (in the outputs' units); error_bound: (n,) ebar of the initial error.
+    noise_bound: (p,) vbar (in the outputs' units); error_bound: (n,) ebar of the initial error;
+    track: keep the reductions' coefficient maps (see :func:`uvsym.sets.carry_coefficients`).
     Raises SetError for a bound that is not finite and non-negative or of the wrong size,
     SetDivergenceError when the enclosure grows (an unstable F, or reduction wrapping)."""
     n, p = design.F.shape[0], design.C.shape[0]
@@ -79,7 +80,8 @@ def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, ge
     A = np.block([[design.F, -design.K1], [np.zeros((p, n + p))]])
     noise = Zonotope(np.zeros(n + p), np.vstack([-design.Q @ V, V]))
     initial = Zonotope(np.zeros(n + p), np.block([[np.diag(ebar), np.zeros((n, p))], [np.zeros((p, n)), V]]))
-    return propagate(A, np.hstack([design.C, np.eye(p)]), initial, noise, steps, generators, method, growth_limit)
+    return propagate(A, np.hstack([design.C, np.eye(p)]), initial, noise, steps, generators, method, growth_limit,
+                     track)
 
 
 def outside_band(residuals, bands: Propagation, tolerance: float = 1e-12) -> np.ndarray:

@@ -29,8 +29,8 @@ __all__ = ["Propagation", "propagate", "carry_coefficients"]
 class Propagation:
     """outputs: r_k's zonotope per step (N entries); lower, upper: (N, n_r) interval hulls;
     exact_radius: (N, n_r) hull radius of the unreduced output sets; reductions: per step k >= 1,
-    the coefficient map R_k of its reduction (``G_before = G_after R_k``); noise_generators: W's
-    generator count."""
+    the coefficient map R_k of its reduction (``G_before = G_after R_k``; empty unless tracked);
+    noise_generators: W's generator count."""
 
     outputs: list
     lower: np.ndarray
@@ -41,10 +41,11 @@ class Propagation:
 
 
 def propagate(A, C, initial: Zonotope, noise: Zonotope, steps: int, generators: int, method: str = "girard",
-              growth_limit: float = 10.0) -> Propagation:
+              growth_limit: float = 10.0, track: bool = True) -> Propagation:
     """Output zonotopes ``C X_k``, k = 0 .. steps - 1 (module docstring).
 
-    A (n, n), C (n_r, n); initial, noise: zonotopes in R^n; generators: the order bound of X_k.
+    A (n, n), C (n_r, n); initial, noise: zonotopes in R^n; generators: the order bound of X_k;
+    track: keep each reduction's coefficient map (for :func:`carry_coefficients`; else none).
 
     Raises
     ------
@@ -75,9 +76,10 @@ def propagate(A, C, initial: Zonotope, noise: Zonotope, steps: int, generators: 
         if k:
             noise_radius += np.sum(np.abs(C @ power @ noise.generators), axis=1)
             power = A @ power
-            step = reduce(X.map(A) + noise, generators, method)
+            step = reduce(X.map(A) + noise, generators, method, coefficients=track)
             X = step.zonotope
-            reductions.append(step.coefficients)
+            if track:
+                reductions.append(step.coefficients)
         out = X.map(C)
         outputs.append(out)
         lower[k], upper[k] = out.interval_hull()
@@ -98,6 +100,8 @@ def carry_coefficients(propagation: Propagation, initial_coefficients, noise_coe
     ``w_k = c_W + G_W eta_k``). Then ``r_k = center_k + G_k a_k`` for the sampled trajectory, with
     ``||a_k||_inf <= 1`` whenever every input coefficient is.
     """
+    if len(propagation.reductions) != len(propagation.outputs) - 1:
+        raise SetError("the propagation kept no coefficient maps: propagate it with track=True")
     a = np.asarray(initial_coefficients, dtype=float)
     eta = np.asarray(noise_coefficients, dtype=float)
     widest = max(z.order for z in propagation.outputs)

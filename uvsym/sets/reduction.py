@@ -93,5 +93,5 @@ def _coefficients(replaced: np.ndarray, rotated: np.ndarray, s: np.ndarray) -> n
     kept, axes = np.flatnonzero(~replaced), np.flatnonzero(s > 0)
     R = np.zeros((kept.size + axes.size, replaced.size))
     R[np.arange(kept.size), kept] = 1.0
-    R[np.ix_(kept.size + np.arange(axes.size), np.flatnonzero(replaced))] = rotated[axes] / s[axes, None]
+    R[kept.size:, replaced] = rotated[axes] / s[axes, None]
     return R
