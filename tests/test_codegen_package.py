@@ -257,3 +257,20 @@ def test_bad_examples_and_units_are_typed_errors(docking, tmp_path):
         write_package(tmp_path, list(made.exported), "pkg", example=Example("nowhere_step", rows, "x"))
     with pytest.raises(CodegenError, match="example must be an Example"):
         ObserverSet("pkg", "d", made.exported, example={"x": 1})
+
+
+def test_the_documented_rk4_stability_bound_of_the_exported_steps(docking):
+    """bias_step (momentum form: e' = -K e) amplifies an error by the RK4 polynomial of z = K dt:
+    below 1 in size up to z = 2.785, above 1 beyond, as its description says (2.78)."""
+    made, _, _ = docking
+    step = next(e for e in made.exported if e.function.name() == "bias_step")
+    assert "below 2.78" in step.description
+    rng = np.random.default_rng(1)
+    eta, nu, tau_d = rng.normal(size=6), rng.normal(size=6), 10 * rng.normal(size=6)
+    x0, delta, dt = rng.normal(size=6), 1e-3 * np.ones(6), 0.01
+    for z in (0.5, 2.7, 2.9):
+        K = np.full(6, z / dt)
+        base, moved = (np.asarray(_raw(step.function)(x, eta, nu, tau_d, K, dt)[0]).ravel() for x in (x0, x0 + delta))
+        factor = (moved - base) / delta
+        np.testing.assert_allclose(factor, 1 - z + z**2 / 2 - z**3 / 6 + z**4 / 24, rtol=1e-6)
+        assert (np.abs(factor) < 1).all() == (z < 2.78)

@@ -27,8 +27,10 @@ from uvsym.codegen.example import Example
 from uvsym.codegen.observer_sets import ObserverSet
 from uvsym.codegen.package import Exported
 from uvsym.conventions import FORCE_LABELS
+from uvsym.faults import actuator_kind
 from uvsym.models.registry import vehicle as library_vehicle
 from uvsym.observers.actuator import KINDS, actuator_observer
+from uvsym.observers.discrete import gain_units
 from uvsym.sim.scenario import ObserverSpec, load_scenario, read_scenario_file, shipped_scenarios
 from uvsym.sim.simulation import scenario_observers, simulate_scenario
 from uvsym.symbolic import rk4
@@ -38,21 +40,6 @@ __all__ = ["EXAMPLE_START", "EXAMPLE_STEPS", "actuator_observers"]
 EXAMPLE_START = 10.0  # s into the scenario: the observers have converged on the faults present from t = 0
 EXAMPLE_STEPS = 500  # samples of the example (5 s of the docking experiment)
 PAPER = paper("liu2014")
-
-
-def _gain_units(model, kind: str, form: str) -> tuple[str, ...]:
-    """Unit of each channel's K: the rate is k tau_d^2 / m^2 (proportional) or k / m^2, with m the
-    channel's mass or inertia (paper form), or k tau_d^2 and k (momentum form)."""
-    units = []
-    for force, velocity in zip(model.force_units, model.state_units[model.dof:]):
-        force = "*".join(force.split())
-        mass = "kg" if velocity == "m/s" else "(kg*m^2)"
-        scale = "" if form == "momentum" else f"{mass}^2"
-        if kind == "proportional":
-            units.append(f"{scale or '1'}/(s*{force}^2)" if "*" not in force else f"{scale or '1'}/(s*({force})^2)")
-        else:
-            units.append(f"{scale}/s" if scale else "1/s")
-    return tuple(units)
 
 
 def _step(function: ca.Function, name: str) -> ca.Function:
@@ -119,10 +106,10 @@ def actuator_observers(vehicle: str = "remus100", form: str = "momentum") -> Obs
     exported, steps = [], []
     for kind in KINDS:
         observer = actuator_observer(model, kind, form).function
-        f_units = ("-",) * n if kind == "proportional" else model.force_units
+        f_units = tuple(map(actuator_kind(kind).unit, model.force_units))
         state = Entries(f"observer state x = f_hat + R(nu) of the {kind} observer", forces, f_units)
         estimate = Entries(f"f_hat, {kind} fault estimate", forces, f_units)
-        gain = Entries(f"K, gains of the {kind} observer", forces, _gain_units(model, kind, form))
+        gain = Entries(f"K, gains of the {kind} observer", forces, gain_units(kind, form, model.force_units))
         inputs = (state, pose, velocity, desired, gain)
         rate = Entries("x_dot, rate of the observer state", forces, tuple(per_second(u) for u in state.units))
         exported.append(Exported(observer, inputs, (rate, estimate),
@@ -130,8 +117,10 @@ def actuator_observers(vehicle: str = "remus100", form: str = "momentum") -> Obs
         step = _step(observer, f"{kind}_step")
         steps.append(step)
         following = Entries("x_next, observer state after dt", forces, state.units)
+        decay = ("K tau_d^2" if kind == "proportional" else "K") + ("" if form == "momentum" else " / m^2")
         exported.append(Exported(step, (*inputs, Entries("dt, step", ("dt",), ("s",))), (following, estimate),
-                                 f"{kind} observer of {model.name} ({form} form): one RK4 step of dt"))
+                                 f"{kind} observer of {model.name} ({form} form): one RK4 step of dt, explicit: "
+                                 f"stable while dt times the decay rate {decay} of every channel stays below 2.78"))
     x, eta, nu, tau_d, K, dt = (ca.SX.sym(v, size) for v, size in
                                 (("x", 3 * n), ("eta", n), ("nu", n), ("tau_d", n), ("K", 3 * n), ("dt", 1)))
     parts = [step(x[i * n:(i + 1) * n], eta, nu, tau_d, K[i * n:(i + 1) * n], dt) for i, step in enumerate(steps)]
@@ -150,7 +139,8 @@ def actuator_observers(vehicle: str = "remus100", form: str = "momentum") -> Obs
     exported.append(Exported(combined, (stacked("observer states", 0), pose, velocity, desired, stacked("gains K", 4),
                                         Entries("dt, step", ("dt",), ("s",))),
                              (stacked("x_next", 0, 0), stacked("f_hat", 0, 1)),
-                             f"the {order} observers of {model.name} ({form} form): one RK4 step each"))
+                             f"the {order} observers of {model.name} ({form} form): one RK4 step each "
+                             f"(explicit: stable while dt times each observer's decay rate stays below 2.78)"))
     description = f"actuator-fault observers of {PAPER.short} for {model.name}, {form} form"
     return ObserverSet(f"uvsym_{vehicle}_observers", description, tuple(exported), citation=PAPER.reference(),
                        example=_example(vehicle, form))
