@@ -42,8 +42,8 @@ def _thrust(result: SimResult, scenario: Scenario, path: Path) -> None:
 
 
 def _states(result: SimResult, scenario: Scenario, path: Path) -> None:
-    fig = plt.figure(figsize=(8, 6))
-    top = fig.add_subplot(2, 1, 1)
+    fig, axes = plt.subplot_mosaic([["path", "psi"], ["path", "v"]], figsize=(9, 5.5))
+    top = axes["path"]
     waypoints = np.asarray(scenario.path.waypoints)
     top.plot(waypoints[:, 1], waypoints[:, 0], "k:", lw=0.8, label="waypoints")
     top.plot(result["x"]["y"][::STRIDE], result["x"]["x"][::STRIDE], "k", lw=1.2, label="true")
@@ -55,15 +55,16 @@ def _states(result: SimResult, scenario: Scenario, path: Path) -> None:
     top.set_aspect("equal")
     top.legend(fontsize=7, loc="center")
     t = result.t[::STRIDE]
-    for k, (state, unit) in enumerate((("psi", "rad"), ("v", "m/s"))):
-        ax = fig.add_subplot(2, 2, 3 + k)
+    for state, unit in (("psi", "rad"), ("v", "m/s")):
+        ax = axes[state]
         _windows(ax, scenario)
         ax.plot(t, result["x"][state][::STRIDE], "k", lw=1.0, label="true")
         for method, label, colour in BANKS:
             ax.plot(t, result[f"{method}_bank"][f"{state}_hat"][::STRIDE], colour, lw=0.6, ls="--", label=label)
-        ax.set_xlabel("time (s)")
         ax.set_ylabel(f"{state} ({unit})")
         ax.legend(fontsize=6)
+    axes["v"].set_xlabel("time (s)")
+    fig.tight_layout()
     save_svg(fig, path)
 
 
@@ -94,7 +95,7 @@ def _efficiency(result: SimResult, scenario: Scenario, path: Path) -> None:
             ax.plot(t[::STRIDE], result[f"{method}_bank"][f"{side}.alpha_{thruster}_hat"][::STRIDE], colour,
                     lw=0.7, label=f"{label}: {side} model's estimate")
         ax.set_ylabel(f"alpha {thruster} (-)")
-        ax.set_ylim(0.0, 1.6)
+        ax.set_ylim(0.0, 2.5)
         ax.legend(fontsize=7, loc="lower left")
     axes[-1].set_xlabel("time (s)")
     save_svg(fig, path)
