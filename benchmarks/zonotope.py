@@ -20,16 +20,18 @@ Times are medians of repeated batches within this one run (the machine may be sh
 from __future__ import annotations
 
 import sys
-import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import finish  # noqa: E402
+from rhs import median_time  # noqa: E402
+
 from derivations.uio_zonotope.design import ERROR_BOUND, GENERATORS, REDUCTION, design  # noqa: E402
 from uvsym.observers.uio_bank import residual_bands  # noqa: E402
-from uvsym.report import write_json  # noqa: E402
 from uvsym.sets import METHODS, Zonotope, reduce  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "zonotope.json"
@@ -39,14 +41,8 @@ BAND_SAMPLES = 300
 
 
 def median_us(call, repeat: int = 7, number: int = 200) -> float:
-    """Median microseconds per call over ``repeat`` batches of ``number`` calls."""
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            call()
-        times.append((time.perf_counter() - start) / number)
-    return float(np.median(times)) * 1e6
+    """Median microseconds per call (:func:`rhs.median_time`)."""
+    return median_time(call, repeat, number) * 1e6
 
 
 def pypolycontain_us(center: np.ndarray, G: np.ndarray) -> dict | None:
@@ -92,12 +88,9 @@ def main() -> dict:
                                                       f"{GENERATORS_OUT} generators",
                "speedup_vs_pypolycontain": speedup, "step_us": step_us, "step_with_maps_us": step_tracked_us,
                "step_task": f"{len(d.bank.designs)} observers, joint zonotopes of dimension {2 * n} bounded to "
-                            f"{GENERATORS} generators ({REDUCTION}), per sample",
-               "targets": TARGETS,
-               "met": None if speedup is None else speedup >= TARGETS["speedup_vs_pypolycontain_min"]}
-    write_json(RESULTS, results)
-    return results
+                            f"{GENERATORS} generators ({REDUCTION}), per sample"}
+    return finish(results, TARGETS, RESULTS)
 
 
 if __name__ == "__main__":
-    print(main())
+    main()

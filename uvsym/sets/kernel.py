@@ -25,11 +25,14 @@ SOURCE = r"""
 #include <stdlib.h>
 
 /* G: n x m row-major. Replaces the `count` generators of smallest score by the box of their
-   absolute row sums. out: n x (m - count + n) row-major, filled with the kept generators (in
-   order) then the non-zero box columns; replaced[j] = 1 for a replaced generator, box[i] the
-   row sums. Returns the number of columns written. score, order: work arrays of m entries. */
-int uvsym_box_reduce(int n, int m, int count, int combastel, const double *G, double *out,
-                     unsigned char *replaced, double *box, double *score, int *order) {
+   absolute row sums. work holds, in order: out, n x (m - count + n) doubles row-major, filled
+   with the kept generators (in order) then the non-zero box columns; box, n doubles (the row
+   sums); score, m doubles; order, m ints; replaced, m bytes (1 for a replaced generator).
+   Returns the number of columns written. */
+int uvsym_box_reduce(int n, int m, int count, int combastel, const double *G, void *work) {
+    double *out = (double *)work, *box = out + n * (m - count + n), *score = box + n;
+    int *order = (int *)(score + m);
+    unsigned char *replaced = (unsigned char *)(order + m);
     for (int j = 0; j < m; ++j) {
         double sum = 0.0, largest = 0.0, squares = 0.0;
         for (int i = 0; i < n; ++i) {
@@ -84,13 +87,13 @@ def _library():
     source, library = folder / "box_reduce.c", folder / "box_reduce.so"
     source.write_text(SOURCE)
     try:
-        subprocess.run([compiler, "-O2", "-fPIC", "-shared", "-o", str(library), str(source), "-lm"], check=True,
-                       capture_output=True, timeout=120)
+        subprocess.run([compiler, "-O3", "-march=native", "-fPIC", "-shared", "-o", str(library), str(source), "-lm"],
+                       check=True, capture_output=True, timeout=120)
         lib = ctypes.CDLL(str(library))
     except (OSError, subprocess.SubprocessError):
         return None
     function = lib.uvsym_box_reduce
-    function.argtypes = [ctypes.c_int] * 4 + [ctypes.c_void_p] * 6  # addresses of contiguous arrays (below)
+    function.argtypes = [ctypes.c_int] * 4 + [ctypes.c_void_p] * 2  # addresses of G and the work buffer
     function.restype = ctypes.c_int
     return function
 
@@ -101,10 +104,15 @@ def _address(array: np.ndarray) -> int:
 
 @functools.lru_cache(maxsize=16)
 def _workspace(n: int, m: int, count: int) -> tuple:
-    """Buffers (out, replaced, box, score, order) reused across calls of one shape, and their addresses."""
-    buffers = (np.empty((n, m - count + n)), np.empty(m, dtype=np.uint8), np.empty(n), np.empty(m),
-               np.empty(m, dtype=np.int32))
-    return buffers, tuple(_address(b) for b in buffers)
+    """One work buffer per shape (the C layout), numpy views of its out, replaced and box parts,
+    and its address as a ctypes pointer."""
+    width = m - count + n
+    doubles = n * width + n + m
+    work = np.zeros(doubles * 8 + m * 4 + m, dtype=np.uint8)
+    out = work[:n * width * 8].view(np.float64).reshape(n, width)
+    box = work[n * width * 8:(n * width + n) * 8].view(np.float64)
+    replaced = work[doubles * 8 + m * 4:]
+    return out, replaced, box, ctypes.c_void_p(_address(work)), work
 
 
 def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True):
@@ -117,8 +125,8 @@ def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True)
     if not (G.flags.c_contiguous and G.dtype == np.float64):
         G = np.ascontiguousarray(G, dtype=np.float64)
     n, m = G.shape
-    (out, replaced, box, _, _), addresses = _workspace(n, m, count)
-    columns = function(n, m, count, int(combastel), _address(G), *addresses)
+    out, replaced, box, work, _ = _workspace(n, m, count)
+    columns = function(n, m, count, int(combastel), _address(G), work)
     if not details:
         return out[:, :columns].copy(), None, None
     return out[:, :columns].copy(), replaced.astype(bool), box.copy()
