@@ -10,6 +10,7 @@ from uvsym.observers.actuator import (
     init_state,
     proportional_observer,
 )
+from uvsym.observers.uio import UIOMatrices, uio_conditions, uio_matrices, uio_observer
 
 __all__ = [
     "FORMS",
@@ -20,4 +21,8 @@ __all__ = [
     "constant_observer",
     "init_state",
     "proportional_observer",
+    "UIOMatrices",
+    "uio_conditions",
+    "uio_matrices",
+    "uio_observer",
 ]

@@ -6,6 +6,8 @@ from uvsym.verify.interval import IntervalFunction
 from uvsym.verify.lyapunov import exact_positive_definite, lyapunov_decrease
 from uvsym.verify.region import region_decrease
 from uvsym.verify.synthesis import GainSynthesis, synthesize_observer_gain
+from uvsym.verify.uio import exact_zoh, uio_existence_claim
 
 __all__ = ["STATUSES", "Certificate", "GainSynthesis", "IntervalFunction", "exact_positive_definite",
-           "lyapunov_decrease", "prove_identity", "region_decrease", "synthesize_observer_gain"]
+           "lyapunov_decrease", "prove_identity", "region_decrease", "synthesize_observer_gain",
+           "exact_zoh", "uio_existence_claim"]
