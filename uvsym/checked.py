@@ -17,6 +17,7 @@ Function, for loops where the checks would cost.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 
 import casadi as ca
@@ -104,27 +105,25 @@ class CheckedFunction(ca.Function):
         if value.size not in (expected, 1) or (value.size == 1 and expected == 0) or not fits:
             raise ArgumentError(f"{self._where()}: argument {name} has {value.size} entries (shape "
                                 f"{value.shape}), expected {expected} (shape {shape})")
-        if np.isfinite(value).all():
-            return
-        bad = np.flatnonzero(~np.isfinite(value.ravel(order="F")))
-        if bad.size:
-            raise ArgumentError(f"{self._where()}: argument {name} {self._entry(name, bad[0], expected)} is "
-                                f"{value.ravel(order='F')[bad[0]]}; every entry must be finite")
+        if not np.isfinite(value).all():
+            flat = value.ravel(order="F")
+            first = int(np.flatnonzero(~np.isfinite(flat))[0])
+            raise ArgumentError(f"{self._where()}: argument {name} {self._entry(name, first, expected)} is "
+                                f"{flat[first]}; every entry must be finite")
 
     def _check_outputs(self, result, values: dict) -> None:
         outputs = result if isinstance(result, dict) else dict(
             zip(self._outputs, result if isinstance(result, tuple) else (result,)))
         for name, value in outputs.items():
-            array = value.full().ravel(order="F")
-            if np.isfinite(array).all():
+            if all(map(math.isfinite, value.nonzeros())):  # structural zeros are finite
                 continue
-            bad = np.flatnonzero(~np.isfinite(array))
-            if bad.size:
-                at = "; ".join(f"{n} = {np.array2string(v.ravel(), precision=6, separator=', ')}"
-                               for n, v in values.items() if v.size)
-                raise ArgumentError(f"{self._where()}: output {name} {self._entry(name, bad[0], array.size)} is "
-                                    f"{array[bad[0]]} at finite arguments ({at}); the point is outside the "
-                                    "equations' domain")
+            array = value.full().ravel(order="F")
+            first = int(np.flatnonzero(~np.isfinite(array))[0])
+            at = "; ".join(f"{n} = {np.array2string(v.ravel(), precision=6, separator=', ')}"
+                           for n, v in values.items() if v.size)
+            raise ArgumentError(f"{self._where()}: output {name} {self._entry(name, first, array.size)} is "
+                                f"{array[first]} at finite arguments ({at}); the point is outside the "
+                                "equations' domain")
 
     def _entry(self, name: str, index: int, size: int) -> str:
         labels = self._labels.get(name, ())

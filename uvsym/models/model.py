@@ -224,7 +224,7 @@ def assemble(name: str, description: str, dof: int, parameters: ParameterSet, eq
         u_max=np.asarray(eq.u_max, dtype=float),
         nu_dot=check(nu_dot_fn),
         f=check(ca.Function("f", [x, u, p], [x_dot], ["x", "u", "p"], ["x_dot"]),
-                _attitude_guard(name) if dof == 6 else None),
+                _AttitudeGuard(name) if dof == 6 else None),
         tau=check(ca.Function("tau", [eta, nu, u, *env], [tau], ["eta", "nu", "u", *env_names], ["tau"])),
         h=check(ca.Function("h", [eta, nu], [h_still], ["eta", "nu"], ["h"])),
         B=check(ca.Function("B", [eta, nu, u, *env], [ca.jacobian(tau, u)], ["eta", "nu", "u", *env_names], ["B"])),
@@ -236,11 +236,15 @@ def assemble(name: str, description: str, dof: int, parameters: ParameterSet, eq
     )
 
 
-def _attitude_guard(name: str):
+@dataclass(frozen=True)
+class _AttitudeGuard:
     """A guard for ``f(x, u, p)`` of a 6-DOF model: KinematicsError where eta' = J(eta) nu is
-    singular (theta = +-90 deg, :func:`~uvsym.kinematics.Tzyx`), which would otherwise give 1e15."""
+    singular (theta = +-90 deg, :func:`~uvsym.kinematics.Tzyx`), which would otherwise give 1e15.
+    A class rather than a closure, so that a Model still pickles."""
 
-    def guard(values: dict) -> None:
+    name: str
+
+    def __call__(self, values: dict) -> None:
         x = values["x"]
         phi, theta = x[3:5] if x.size > 4 else (x[0], x[0])
         if abs(math.cos(theta)) > 1e-6:  # far from it: Tzyx (CasADi on numbers) only decides near it
@@ -248,6 +252,4 @@ def _attitude_guard(name: str):
         try:
             Tzyx(phi, theta)
         except KinematicsError as exc:
-            raise KinematicsError(f"{name}.f: x entry theta: {exc}") from None
-
-    return guard
+            raise KinematicsError(f"{self.name}.f: x entry theta: {exc}") from None
