@@ -158,6 +158,8 @@ def test_bands_enclose_sampled_residuals_and_reject_bad_bounds():
     assert isolate(np.array([[False, True], [False, False]]), ["a", "b"], 0, 2) == ["a"]
     with pytest.raises(SetError, match="noise bound"):
         residual_bands(d, [0.01, np.nan, 0.01], ebar, 10, 24)
+    with pytest.raises(SetError, match="noise bound must be finite"):  # an unbounded channel
+        residual_bands(d, [0.01, np.inf, 0.01], ebar, 10, 24)
     with pytest.raises(SetError, match="non-negative"):
         residual_bands(d, [0.01, -0.01, 0.01], ebar, 10, 24)
     with pytest.raises(SetError, match="initial error bound"):
