@@ -4,6 +4,7 @@ The same computation as :func:`uvsym.sets.reduction.reduce` for ``girard`` and `
 (scores, the ``count`` smallest replaced by a box, kept generators in their order), in one C
 call through ctypes instead of a dozen numpy calls. Ties in the score go to the lower index.
 Without a C compiler (or when the build fails) :func:`box_reduce` is None and the numpy path runs.
+The work buffer is shared per shape within a process: not for concurrent calls from threads.
 """
 
 from __future__ import annotations
@@ -25,24 +26,33 @@ SOURCE = r"""
 #include <stdlib.h>
 
 /* G: n x m row-major. Replaces the `count` generators of smallest score by the box of their
-   absolute row sums. work holds, in order: out, n x (m - count + n) doubles row-major, filled
+   absolute row sums. work holds, in order: G, n x m doubles row-major (the input); out,
+   n x (m - count + n) doubles row-major, filled
    with the kept generators (in order) then the non-zero box columns; box, n doubles (the row
-   sums); score, m doubles; order, m ints; replaced, m bytes (1 for a replaced generator).
+   sums); score and largest, m doubles each; order, m ints; replaced, m bytes (1 for a
+   replaced generator).
    Returns the number of columns written. */
-int uvsym_box_reduce(int n, int m, int count, int combastel, const double *G, void *work) {
-    double *out = (double *)work, *box = out + n * (m - count + n), *score = box + n;
-    int *order = (int *)(score + m);
+int uvsym_box_reduce(int n, int m, int count, int combastel, void *work) {
+    const double *G = (const double *)work;
+    double *out = (double *)work + n * m, *box = out + n * (m - count + n), *score = box + n;
+    double *largest = score + m;
+    int *order = (int *)(largest + m);
     unsigned char *replaced = (unsigned char *)(order + m);
-    for (int j = 0; j < m; ++j) {
-        double sum = 0.0, largest = 0.0, squares = 0.0;
-        for (int i = 0; i < n; ++i) {
-            double a = fabs(G[i * m + j]);
-            sum += a; squares += a * a; largest = a > largest ? a : largest;
+    for (int j = 0; j < m; ++j) { score[j] = 0.0; largest[j] = 0.0; order[j] = j; replaced[j] = 0; }
+    for (int i = 0; i < n; ++i) {  /* row by row: contiguous, vectorisable */
+        const double *row = G + i * m;
+        if (combastel) {
+            for (int j = 0; j < m; ++j) score[j] += row[j] * row[j];
+        } else {
+            for (int j = 0; j < m; ++j) {
+                double a = fabs(row[j]);
+                score[j] += a;
+                largest[j] = a > largest[j] ? a : largest[j];
+            }
         }
-        score[j] = combastel ? squares : sum - largest;
-        order[j] = j;
-        replaced[j] = 0;
     }
+    if (!combastel)
+        for (int j = 0; j < m; ++j) score[j] -= largest[j];
     /* quickselect: the `count` smallest (score, index) pairs end up in order[0 .. count-1] */
     int lo = 0, hi = m - 1, k = count - 1;
     while (lo < hi) {
@@ -57,16 +67,18 @@ int uvsym_box_reduce(int n, int m, int count, int combastel, const double *G, vo
         if (k <= j) hi = j; else if (k >= i) lo = i; else break;
     }
     for (int c = 0; c < count; ++c) replaced[order[c]] = 1;
-    int width = m - count + n, col = 0;
-    for (int i = 0; i < n; ++i) box[i] = 0.0;
-    for (int j = 0; j < m; ++j) {
-        if (replaced[j]) {
-            for (int i = 0; i < n; ++i) box[i] += fabs(G[i * m + j]);
-        } else {
-            for (int i = 0; i < n; ++i) out[i * width + col] = G[i * m + j];
-            ++col;
+    int width = m - count + n, kept = m - count;
+    for (int i = 0; i < n; ++i) {
+        const double *row = G + i * m;
+        double *target = out + i * width, sum = 0.0;
+        int col = 0;
+        for (int j = 0; j < m; ++j) {
+            if (replaced[j]) sum += fabs(row[j]);
+            else target[col++] = row[j];
         }
+        box[i] = sum;
     }
+    int col = kept;
     for (int i = 0; i < n; ++i) {
         if (box[i] > 0.0) {
             for (int r = 0; r < n; ++r) out[r * width + col] = r == i ? box[i] : 0.0;
@@ -93,7 +105,7 @@ def _library():
     except (OSError, subprocess.SubprocessError):
         return None
     function = lib.uvsym_box_reduce
-    function.argtypes = [ctypes.c_int] * 4 + [ctypes.c_void_p] * 2  # addresses of G and the work buffer
+    function.argtypes = [ctypes.c_int] * 4 + [ctypes.c_void_p]  # the work buffer's address
     function.restype = ctypes.c_int
     return function
 
@@ -104,15 +116,17 @@ def _address(array: np.ndarray) -> int:
 
 @functools.lru_cache(maxsize=16)
 def _workspace(n: int, m: int, count: int) -> tuple:
-    """One work buffer per shape (the C layout), numpy views of its out, replaced and box parts,
-    and its address as a ctypes pointer."""
+    """One work buffer per shape (the C layout), numpy views of its G, out, replaced and box parts,
+    and its address as a ctypes pointer. G is copied in (cheaper than reading an array's address)."""
     width = m - count + n
-    doubles = n * width + n + m
+    doubles = n * m + n * width + n + 2 * m
     work = np.zeros(doubles * 8 + m * 4 + m, dtype=np.uint8)
-    out = work[:n * width * 8].view(np.float64).reshape(n, width)
-    box = work[n * width * 8:(n * width + n) * 8].view(np.float64)
+    as_doubles = work[:doubles * 8].view(np.float64)
+    G = as_doubles[:n * m].reshape(n, m)
+    out = as_doubles[n * m:n * m + n * width].reshape(n, width)
+    box = as_doubles[n * m + n * width:n * m + n * width + n]
     replaced = work[doubles * 8 + m * 4:]
-    return out, replaced, box, ctypes.c_void_p(_address(work)), work
+    return G, out, replaced, box, ctypes.c_void_p(_address(work)), work
 
 
 def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True):
@@ -122,11 +136,10 @@ def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True)
     function = _library()
     if function is None:
         return None
-    if not (G.flags.c_contiguous and G.dtype == np.float64):
-        G = np.ascontiguousarray(G, dtype=np.float64)
     n, m = G.shape
-    out, replaced, box, work, _ = _workspace(n, m, count)
-    columns = function(n, m, count, int(combastel), _address(G), work)
+    G_in, out, replaced, box, work, _ = _workspace(n, m, count)
+    G_in[...] = G
+    columns = function(n, m, count, int(combastel), work)
     if not details:
         return out[:, :columns].copy(), None, None
     return out[:, :columns].copy(), replaced.astype(bool), box.copy()
