@@ -2,7 +2,8 @@
 
 ``prove_identity`` converts ``lhs - rhs`` (CasADi SX) to sympy by walking the graph, with every
 double constant converted exactly to a rational. Then, in a child process with a time budget
-(``SYMBOLIC_SECONDS``; a symbolic step that takes longer is abandoned, never waited for):
+(``SYMBOLIC_SECONDS`` of CPU time, so that a loaded machine gives the same outcome; a symbolic step
+that takes longer is abandoned, never waited for):
 
 1. exact rational arithmetic: each entry, with its transcendental sub-expressions (sin, exp,
    atan2, ...) as independent symbols, is expanded (or cancelled, with a symbolic denominator);
@@ -20,7 +21,9 @@ evidence at N points, never a proof); anything between is inconclusive.
 
 from __future__ import annotations
 
+import math
 import multiprocessing
+import resource
 import time
 
 import casadi as ca
@@ -36,7 +39,8 @@ __all__ = ["prove_identity", "exact_zero"]
 
 DIGITS = 50
 REFUTE, ROUNDING = 1e-10, 1e-12
-SYMBOLIC_SECONDS = 4.0
+SYMBOLIC_SECONDS = 4.0  # CPU seconds of the symbolic steps
+WALL_FACTOR = 20  # wall-clock allowance of a loaded machine, per CPU second
 SIMPLIFY_OPS = 200  # entries larger than this are not handed to sympy.simplify
 
 
@@ -71,8 +75,11 @@ def exact_zero(expression: sp.Expr) -> bool:
     return sp.expand(numerator) == 0 and denominator != 0
 
 
-def _symbolic_outcome(entries: list[sp.Expr], channel) -> None:
-    """In the child: send "exact", "simplify" or "" (not shown to be zero) for the whole difference."""
+def _symbolic_outcome(entries: list[sp.Expr], channel, seconds: float) -> None:
+    """In the child: send "exact", "simplify" or "" (not shown to be zero) for the whole difference;
+    the child is stopped after ``seconds`` of CPU time (so a loaded machine does not change the outcome)."""
+    limit = max(1, math.ceil(seconds))
+    resource.setrlimit(resource.RLIMIT_CPU, (limit + int(time.process_time()), resource.RLIM_INFINITY))
     how = "exact"
     for entry in entries:
         if exact_zero(entry):
@@ -86,13 +93,17 @@ def _symbolic_outcome(entries: list[sp.Expr], channel) -> None:
 
 
 def _symbolic(entries: list[sp.Expr], seconds: float) -> str:
-    """"exact", "simplify", "" (not zero) or "timeout", from a child process given ``seconds``."""
+    """"exact", "simplify", "" (not zero) or "timeout", from a child process given ``seconds`` of CPU
+    time (and at most ``WALL_FACTOR`` times that of wall-clock time)."""
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
-    child = context.Process(target=_symbolic_outcome, args=(entries, send), daemon=True)
+    child = context.Process(target=_symbolic_outcome, args=(entries, send, seconds), daemon=True)
     child.start()
-    ready = receive.poll(seconds)
-    outcome = receive.recv() if ready else "timeout"
+    send.close()
+    try:
+        outcome = receive.recv() if receive.poll(WALL_FACTOR * max(1.0, seconds)) else "timeout"
+    except EOFError:  # the child hit its CPU limit
+        outcome = "timeout"
     if child.is_alive():
         child.kill()
     child.join()

@@ -259,21 +259,26 @@ def _branch_and_bound(decrease: _Decrease, lower, upper, cube: float, scale, max
     """Boxes outside the cube: {"boxes", "worst"} when all are proved, plus "counterexample" (a
     point), "undefined" (a point) or "open" (a box, described) when the search stops."""
     queue_lo, queue_hi = lower[None, :], upper[None, :]
-    boxes, worst, settled, volume = 0, -np.inf, 0.0, float(np.prod(upper - lower))
+    boxes, worst, settled = 0, -np.inf, 0.0
+    side_lengths = upper - lower  # progress in fractions of the box (no under- or overflow of volumes)
+
+    def share(lo, hi) -> float:
+        return float(np.sum(np.prod((hi - lo) / side_lengths, axis=1)))
+
     bar = ProgressBar(f"branch-and-bound {claim[:40]}")
     try:
         while len(queue_lo):
             lo, hi = queue_lo[:batch], queue_hi[:batch]
             queue_lo, queue_hi = queue_lo[batch:], queue_hi[batch:]
             outside = ~np.all((lo >= -cube) & (hi <= cube), axis=1)
-            settled += float(np.sum(np.prod(hi[~outside] - lo[~outside], axis=1)))
+            settled += share(lo[~outside], hi[~outside])
             lo, hi = lo[outside], hi[outside]
             boxes += len(lo)
             bound = decrease.upper_bound(lo, hi)
             done = bound < 0
             if np.any(done):
                 worst = max(worst, float(np.max(bound[done])))
-                settled += float(np.sum(np.prod(hi[done] - lo[done], axis=1)))
+                settled += share(lo[done], hi[done])
             lo, hi = lo[~done], hi[~done]
             if not len(lo):
                 continue
@@ -293,7 +298,7 @@ def _branch_and_bound(decrease: _Decrease, lower, upper, cube: float, scale, max
             left_hi[rows, side], right_lo[rows, side] = middle, middle
             queue_lo = np.concatenate([queue_lo, lo, right_lo])
             queue_hi = np.concatenate([queue_hi, left_hi, hi])
-            bar(settled / volume)
+            bar(settled)
     finally:
         bar.close()
     return {"boxes": boxes, "worst": worst}
