@@ -1,5 +1,5 @@
 /* Test harness: each record on stdin is a function index then its inputs, all as text;
-   prints that function's outputs on one line. Used to compare C with Python. */
+   prints that function's return code, then its outputs, on one line. Used to compare C with Python. */
 #include <stdio.h>
 #include "uvsym_docking_auv_observers.h"
 
@@ -16,9 +16,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_proportional_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_proportional_observer(in0, in1, in2, in3, in4, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 1: {
@@ -29,9 +29,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_proportional_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_proportional_step(in0, in1, in2, in3, in4, in5, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 2: {
@@ -41,9 +41,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_bias_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_bias_observer(in0, in1, in2, in3, in4, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 3: {
@@ -54,9 +54,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_bias_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_bias_step(in0, in1, in2, in3, in4, in5, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 4: {
@@ -66,9 +66,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_constant_observer(in0, in1, in2, in3, in4, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_constant_observer(in0, in1, in2, in3, in4, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 5: {
@@ -79,9 +79,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_constant_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 6; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_constant_step(in0, in1, in2, in3, in4, in5, out0, out1));
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 6; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     case 6: {
@@ -92,9 +92,9 @@ int main(void) {
       for (i = 0; i < 6; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 18; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_docking_auv_observers_real)v;
       for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in5[i] = (uvsym_docking_auv_observers_real)v;
-      if (uvsym_docking_auv_observers_actuator_observers_step(in0, in1, in2, in3, in4, in5, out0, out1)) return 2;
-      for (i = 0; i < 18; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 18; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_docking_auv_observers_actuator_observers_step(in0, in1, in2, in3, in4, in5, out0, out1));
+      for (i = 0; i < 18; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 18; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     default:

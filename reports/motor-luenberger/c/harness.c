@@ -1,5 +1,5 @@
 /* Test harness: each record on stdin is a function index then its inputs, all as text;
-   prints that function's outputs on one line. Used to compare C with Python. */
+   prints that function's return code, then its outputs, on one line. Used to compare C with Python. */
 #include <stdio.h>
 #include "uvsym_induction_motor.h"
 
@@ -15,9 +15,9 @@ int main(void) {
       for (i = 0; i < 3; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_induction_motor_real)v;
       for (i = 0; i < 2; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_induction_motor_real)v;
       for (i = 0; i < 0; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_induction_motor_real)v;
-      if (uvsym_induction_motor_luenberger_step(in0, in1, in2, in3, out0, out1)) return 2;
-      for (i = 0; i < 5; ++i) printf("%.17g ", (double)out0[i]);
-      for (i = 0; i < 8; ++i) printf("%.17g ", (double)out1[i]);
+      printf("%d", uvsym_induction_motor_luenberger_step(in0, in1, in2, in3, out0, out1));
+      for (i = 0; i < 5; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 8; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
     default:
