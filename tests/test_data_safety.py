@@ -48,11 +48,9 @@ def test_codegen_refuses_a_folder_with_a_hand_written_main_and_accepts_its_own(t
     assert main(["codegen", "motor-luenberger", "-o", str(out)]) == 2
     assert "holds files uvsym did not write (main.c)" in capsys.readouterr().err
     assert (out / "main.c").read_text() == "int main(void) { return 42; }\n"
-    own = tmp_path / "own"
-    assert main(["codegen", "motor-luenberger", "-o", str(own)]) == 0
-    assert main(["codegen", "motor-luenberger", "-o", str(own)]) == 0  # its own package: rewritten
     assert main(["codegen", "motor-luenberger", "-o", str(out), "--force"]) == 0
     assert json.loads((out / "manifest.json").read_text())["functions"]
+    assert claim_folder(out, "the C package", "package") == out  # now its own package: rewritten without --force
 
 
 def test_report_checks_every_folder_before_building_any(tmp_path, capsys):

@@ -65,7 +65,7 @@ def test_the_cases_that_used_to_lose_data(tmp_path, suffix):
     _assert_same(SimResult.load(result.save(tmp_path / f"r{suffix}")), result)
 
 
-def test_names_and_shapes_that_no_format_can_hold_are_refused():
+def test_names_and_shapes_that_no_format_can_hold_are_refused(tmp_path):
     with pytest.raises(SimulationError, match="a signal name must be a non-empty string"):
         SimResult(np.zeros(2), {"": Signal(np.zeros((2, 1)), ("a",), ("m",))})
     with pytest.raises(SimulationError, match="label 0 must be a string without control characters"):
@@ -75,7 +75,8 @@ def test_names_and_shapes_that_no_format_can_hold_are_refused():
     with pytest.raises(SimulationError, match="one row per time"):
         SimResult(np.zeros(3), {"x": Signal(np.zeros((2, 1)), ("a",), ("m",))})
     with pytest.raises(SimulationError, match="meta must be JSON-friendly"):
-        SimResult(np.zeros(1), {}, {"when": object()})
+        SimResult(np.zeros(1), {}, {"when": object()}).save(tmp_path / "r.npz")
+    assert not (tmp_path / "r.npz").exists()
 
 
 def test_existing_files_are_kept_unless_overwrite(tmp_path):

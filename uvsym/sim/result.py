@@ -69,8 +69,8 @@ class Signal:
 class SimResult:
     """t: (N,) s; signals: name -> Signal (x, y, u_desired, u_command, u_expected, u_actual,
     fault_actuator, fault_sensor, tau_desired, reference, f_hat/<observer>; see ``simulate``);
-    meta: JSON-friendly description of the run. Names are non-empty strings without control
-    characters; every signal has one row per time."""
+    meta: description of the run, JSON-friendly to be saved. Names are non-empty strings without
+    control characters; every signal has one row per time."""
 
     t: np.ndarray
     signals: dict[str, Signal]
@@ -84,10 +84,6 @@ class SimResult:
             _text(name, "a signal name", allow_empty=False)
             if not isinstance(sig, Signal) or sig.values.shape[0] != t.size:
                 raise SimulationError(f"signal {name!r} must be a Signal with one row per time ({t.size})")
-        try:
-            json.dumps(self.meta)
-        except (TypeError, ValueError) as exc:
-            raise SimulationError(f"meta must be JSON-friendly: {exc}") from None
         object.__setattr__(self, "t", t)
 
     def __getitem__(self, name: str) -> Signal:
@@ -107,6 +103,10 @@ class SimResult:
         """Write to ``path`` (its folder is made if missing); the suffix (.npz, .csv or .mat) picks the
         format. An existing file is kept (PathError) unless ``overwrite``."""
         path = self.check_path(path, overwrite)
+        try:
+            json.dumps(self.meta)
+        except (TypeError, ValueError) as exc:
+            raise SimulationError(f"cannot save {path}: meta must be JSON-friendly ({exc})") from None
         layout = [{"name": n, "labels": list(s.labels), "units": list(s.units)} for n, s in self.signals.items()]
         try:
             _WRITERS[path.suffix](self, path, layout)
