@@ -66,7 +66,7 @@ def reduce(zonotope: Zonotope, generators: int, method: str = "girard", coeffici
         if compiled is not None:
             new_G, replaced, s = compiled
             reduced = Zonotope.trusted(zonotope.center, new_G)
-            return Reduction(reduced, _coefficients(replaced, G[:, replaced], s) if coefficients else None)
+            return Reduction(reduced, _coefficients(replaced, G, None, s) if coefficients else None)
     if method == "combastel":
         score = np.einsum("ij,ij->j", G, G)
     else:
@@ -85,13 +85,16 @@ def reduce(zonotope: Zonotope, generators: int, method: str = "girard", coeffici
     else:
         B = U[:, axes] * s[axes]
     reduced = Zonotope.trusted(zonotope.center, np.hstack([G[:, ~replaced], B]))
-    return Reduction(reduced, _coefficients(replaced, rotated, s) if coefficients else None)
+    return Reduction(reduced, _coefficients(replaced, G, U, s) if coefficients else None)
 
 
-def _coefficients(replaced: np.ndarray, rotated: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """R (module docstring) from the replaced mask (m,), ``U^T G_s`` and its absolute row sums s."""
+def _coefficients(replaced: np.ndarray, G: np.ndarray, U: np.ndarray | None, s: np.ndarray) -> np.ndarray:
+    """R (module docstring) from the replaced mask (m,), the generators, the parallelotope's axes U
+    (None: the identity) and the absolute row sums s of ``U^T G_s``."""
     kept, axes = np.flatnonzero(~replaced), np.flatnonzero(s > 0)
     R = np.zeros((kept.size + axes.size, replaced.size))
     R[np.arange(kept.size), kept] = 1.0
-    R[kept.size:, replaced] = rotated[axes] / s[axes, None]
+    group = G * replaced  # the replaced generators, the kept ones zeroed
+    rotated = group[axes] if U is None else U[:, axes].T @ group
+    R[kept.size:] = rotated / s[axes, None]
     return R
