@@ -5,14 +5,23 @@ from __future__ import annotations
 from derivations.sensor_fdi_lms.design import MU, ORDER, design
 from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
+from uvsym.codegen.package import Exported
+from uvsym.observers.lms import lms_step
 
 __all__ = ["lms_set"]
 
 
 def lms_set(order: int = ORDER, mu: float = MU) -> ObserverSet:
-    """The compass monitor (LMS-FIR of ``order`` taps, default step ``mu``; mu, eps0, r0 are run-time parameters)."""
+    """The compass monitor (LMS-FIR of ``order`` taps, default step ``mu``; mu, eps0, r0 are run-time
+    parameters) and the bare LMS step it is built on."""
     monitor = design(order=int(order), mu=float(mu)).monitor
+    bare = Exported(lms_step(int(order)),
+                    (f"C: weights ({order}, rad per unit u)", f"U: [u_(k-1) ... u_(k-{order})] (-)",
+                     "target: y - r (rad)", "u: the new input u_k (-)", "mu: LMS step (-)"),
+                    ("C_next: updated weights", "U_next: shifted inputs", "d: prediction C . U (rad)",
+                     "e: d - target (rad)"),
+                    f"LMS-FIR step of order {order}: d = C.U, e = d - target, C_next = C - 2 mu e U")
     return ObserverSet("uvsym_sensor_fdi_lms", f"LMS-FIR compass monitor, order {order}, double criterion",
-                       (exported_observer(monitor),),
+                       (exported_observer(monitor), bare),
                        citation="Zhu Daqi et al., sensor fault diagnosis of an underwater robot with an adaptive "
                                 "FIR filter (LMS), double criterion and measurement substitution")

@@ -20,6 +20,20 @@ int main(void) {
       for (i = 0; i < 10; ++i) printf(" %.17g", (double)out1[i]);
       break;
     }
+    case 1: {
+      uvsym_sensor_fdi_lms_real in0[70]; uvsym_sensor_fdi_lms_real in1[70]; uvsym_sensor_fdi_lms_real in2[1]; uvsym_sensor_fdi_lms_real in3[1]; uvsym_sensor_fdi_lms_real in4[1]; uvsym_sensor_fdi_lms_real out0[70]; uvsym_sensor_fdi_lms_real out1[70]; uvsym_sensor_fdi_lms_real out2[1]; uvsym_sensor_fdi_lms_real out3[1];
+      for (i = 0; i < 70; ++i) if (scanf("%lf", &v) != 1) return 1; else in0[i] = (uvsym_sensor_fdi_lms_real)v;
+      for (i = 0; i < 70; ++i) if (scanf("%lf", &v) != 1) return 1; else in1[i] = (uvsym_sensor_fdi_lms_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in2[i] = (uvsym_sensor_fdi_lms_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in3[i] = (uvsym_sensor_fdi_lms_real)v;
+      for (i = 0; i < 1; ++i) if (scanf("%lf", &v) != 1) return 1; else in4[i] = (uvsym_sensor_fdi_lms_real)v;
+      printf("%d", uvsym_sensor_fdi_lms_lms_fir_step(in0, in1, in2, in3, in4, out0, out1, out2, out3));
+      for (i = 0; i < 70; ++i) printf(" %.17g", (double)out0[i]);
+      for (i = 0; i < 70; ++i) printf(" %.17g", (double)out1[i]);
+      for (i = 0; i < 1; ++i) printf(" %.17g", (double)out2[i]);
+      for (i = 0; i < 1; ++i) printf(" %.17g", (double)out3[i]);
+      break;
+    }
     default:
       return 3;
     }

@@ -511,4 +511,19 @@ typedef casadi_real uvsym_sensor_fdi_lms_real;
  * Uses static work buffers: not reentrant. */
 int uvsym_sensor_fdi_lms_lms_step(const uvsym_sensor_fdi_lms_real s[235], const uvsym_sensor_fdi_lms_real y[1], const uvsym_sensor_fdi_lms_real u[2], const uvsym_sensor_fdi_lms_real p[3], uvsym_sensor_fdi_lms_real s_next[235], uvsym_sensor_fdi_lms_real out[10]);
 
+/* LMS-FIR step of order 70: d = C.U, e = d - target, C_next = C - 2 mu e U
+ *
+ * in  C[70]: C: weights (70, rad per unit u)
+ * in  U[70]: U: [u_(k-1) ... u_(k-70)] (-)
+ * in  target[1]: target: y - r (rad)
+ * in  u[1]: u: the new input u_k (-)
+ * in  mu[1]: mu: LMS step (-)
+ * out C_next[70]: C_next: updated weights
+ * out U_next[70]: U_next: shifted inputs
+ * out d[1]: d: prediction C . U (rad)
+ * out e[1]: e: d - target (rad)
+ * Returns UVSYM_SENSOR_FDI_LMS_OK, UVSYM_SENSOR_FDI_LMS_EVAL_FAILED, UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT or UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT.
+ * Uses static work buffers: not reentrant. */
+int uvsym_sensor_fdi_lms_lms_fir_step(const uvsym_sensor_fdi_lms_real C[70], const uvsym_sensor_fdi_lms_real U[70], const uvsym_sensor_fdi_lms_real target[1], const uvsym_sensor_fdi_lms_real u[1], const uvsym_sensor_fdi_lms_real mu[1], uvsym_sensor_fdi_lms_real C_next[70], uvsym_sensor_fdi_lms_real U_next[70], uvsym_sensor_fdi_lms_real d[1], uvsym_sensor_fdi_lms_real e[1]);
+
 #endif /* UVSYM_SENSOR_FDI_LMS_H */

@@ -22,3 +22,21 @@ int uvsym_sensor_fdi_lms_lms_step(const uvsym_sensor_fdi_lms_real s[235], const 
   if (!uvsym_sensor_fdi_lms_all_finite(out, 10)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT;
   return UVSYM_SENSOR_FDI_LMS_OK;
 }
+
+int uvsym_sensor_fdi_lms_lms_fir_step(const uvsym_sensor_fdi_lms_real C[70], const uvsym_sensor_fdi_lms_real U[70], const uvsym_sensor_fdi_lms_real target[1], const uvsym_sensor_fdi_lms_real u[1], const uvsym_sensor_fdi_lms_real mu[1], uvsym_sensor_fdi_lms_real C_next[70], uvsym_sensor_fdi_lms_real U_next[70], uvsym_sensor_fdi_lms_real d[1], uvsym_sensor_fdi_lms_real e[1]) {
+  static casadi_int iw[uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_IW > 0 ? uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_IW : 1];
+  static casadi_real w[uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_W > 0 ? uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_W : 1];
+  const casadi_real* arg[uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_ARG > 0 ? uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_ARG : 1] = {C, U, target, u, mu};
+  casadi_real* res[uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_RES > 0 ? uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_RES : 1] = {C_next, U_next, d, e};
+  if (!uvsym_sensor_fdi_lms_all_finite(C, 70)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(U, 70)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(target, 1)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(u, 1)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(mu, 1)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT;
+  if (uvsym_sensor_fdi_lms_casadi_lms_fir_step(arg, res, iw, w, 0)) return UVSYM_SENSOR_FDI_LMS_EVAL_FAILED;
+  if (!uvsym_sensor_fdi_lms_all_finite(C_next, 70)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(U_next, 70)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(d, 1)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT;
+  if (!uvsym_sensor_fdi_lms_all_finite(e, 1)) return UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT;
+  return UVSYM_SENSOR_FDI_LMS_OK;
+}

@@ -29,14 +29,19 @@ extern "C" {
 #endif
 
 /* Add prefix to internal symbols */
+#define casadi_copy CASADI_PREFIX(copy)
+#define casadi_dot CASADI_PREFIX(dot)
 #define casadi_f0 CASADI_PREFIX(f0)
+#define casadi_f1 CASADI_PREFIX(f1)
 #define casadi_fmin CASADI_PREFIX(fmin)
 #define casadi_s0 CASADI_PREFIX(s0)
 #define casadi_s1 CASADI_PREFIX(s1)
 #define casadi_s2 CASADI_PREFIX(s2)
 #define casadi_s3 CASADI_PREFIX(s3)
 #define casadi_s4 CASADI_PREFIX(s4)
+#define casadi_s5 CASADI_PREFIX(s5)
 #define casadi_sq CASADI_PREFIX(sq)
+#define casadi_zeros CASADI_PREFIX(zeros)
 
 /* Symbol visibility in DLLs */
 #ifndef CASADI_SYMBOL_EXPORT
@@ -64,6 +69,24 @@ casadi_real casadi_fmin(casadi_real x, casadi_real y) {
 #endif
 }
 
+casadi_real casadi_dot(casadi_int n, const casadi_real* x, const casadi_real* y) {
+  casadi_int i;
+  casadi_real r = 0;
+  for (i=0; i<n; ++i) r += *x++ * *y++;
+  return r;
+}
+
+void casadi_copy(const casadi_real* x, casadi_int n, casadi_real* y) {
+  casadi_int i;
+  if (y) {
+    if (x) {
+      for (i=0; i<n; ++i) *y++ = *x++;
+    } else {
+      for (i=0; i<n; ++i) *y++ = 0.;
+    }
+  }
+}
+
 /* Configuration this file was compiled with */
 CASADI_SYMBOL_EXPORT void uvsym_sensor_fdi_lms_casadi__casadi_version(int* major, int* minor, int* patch) {
   *major = 3;
@@ -78,6 +101,10 @@ static const casadi_int casadi_s1[3] = {1, 1, 1};
 static const casadi_int casadi_s2[3] = {2, 1, 1};
 static const casadi_int casadi_s3[3] = {3, 1, 1};
 static const casadi_int casadi_s4[3] = {10, 1, 1};
+static const casadi_int casadi_s5[3] = {70, 1, 1};
+
+static const casadi_real casadi_zeros[70] = 
+  {0.};
 
 /* uvsym_sensor_fdi_lms_casadi_lms_step:(s[235],y,u[2],p[3])->(s_next[235],out[10]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
@@ -781,357 +808,357 @@ static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a000=(a164?a000:0);
   a166=(!a164);
   a167=arg[0]? arg[0][160] : 0;
-  a167=(a166?a167:0);
-  a000=(a000+a167);
+  a168=(a166?a167:0);
+  a000=(a000+a168);
   if (res[0]!=0) res[0][160]=a000;
   a004=(a164?a004:0);
-  a167=arg[0]? arg[0][161] : 0;
-  a167=(a166?a167:0);
-  a004=(a004+a167);
+  a000=arg[0]? arg[0][161] : 0;
+  a168=(a166?a000:0);
+  a004=(a004+a168);
   if (res[0]!=0) res[0][161]=a004;
   a006=(a164?a006:0);
-  a167=arg[0]? arg[0][162] : 0;
-  a167=(a166?a167:0);
-  a006=(a006+a167);
+  a004=arg[0]? arg[0][162] : 0;
+  a168=(a166?a004:0);
+  a006=(a006+a168);
   if (res[0]!=0) res[0][162]=a006;
   a008=(a164?a008:0);
-  a167=arg[0]? arg[0][163] : 0;
-  a167=(a166?a167:0);
-  a008=(a008+a167);
+  a006=arg[0]? arg[0][163] : 0;
+  a168=(a166?a006:0);
+  a008=(a008+a168);
   if (res[0]!=0) res[0][163]=a008;
   a010=(a164?a010:0);
-  a167=arg[0]? arg[0][164] : 0;
-  a167=(a166?a167:0);
-  a010=(a010+a167);
+  a008=arg[0]? arg[0][164] : 0;
+  a168=(a166?a008:0);
+  a010=(a010+a168);
   if (res[0]!=0) res[0][164]=a010;
   a012=(a164?a012:0);
-  a167=arg[0]? arg[0][165] : 0;
-  a167=(a166?a167:0);
-  a012=(a012+a167);
+  a010=arg[0]? arg[0][165] : 0;
+  a168=(a166?a010:0);
+  a012=(a012+a168);
   if (res[0]!=0) res[0][165]=a012;
   a014=(a164?a014:0);
-  a167=arg[0]? arg[0][166] : 0;
-  a167=(a166?a167:0);
-  a014=(a014+a167);
+  a012=arg[0]? arg[0][166] : 0;
+  a168=(a166?a012:0);
+  a014=(a014+a168);
   if (res[0]!=0) res[0][166]=a014;
   a016=(a164?a016:0);
-  a167=arg[0]? arg[0][167] : 0;
-  a167=(a166?a167:0);
-  a016=(a016+a167);
+  a014=arg[0]? arg[0][167] : 0;
+  a168=(a166?a014:0);
+  a016=(a016+a168);
   if (res[0]!=0) res[0][167]=a016;
   a018=(a164?a018:0);
-  a167=arg[0]? arg[0][168] : 0;
-  a167=(a166?a167:0);
-  a018=(a018+a167);
+  a016=arg[0]? arg[0][168] : 0;
+  a168=(a166?a016:0);
+  a018=(a018+a168);
   if (res[0]!=0) res[0][168]=a018;
   a020=(a164?a020:0);
-  a167=arg[0]? arg[0][169] : 0;
-  a167=(a166?a167:0);
-  a020=(a020+a167);
+  a018=arg[0]? arg[0][169] : 0;
+  a168=(a166?a018:0);
+  a020=(a020+a168);
   if (res[0]!=0) res[0][169]=a020;
   a022=(a164?a022:0);
-  a167=arg[0]? arg[0][170] : 0;
-  a167=(a166?a167:0);
-  a022=(a022+a167);
+  a020=arg[0]? arg[0][170] : 0;
+  a168=(a166?a020:0);
+  a022=(a022+a168);
   if (res[0]!=0) res[0][170]=a022;
   a024=(a164?a024:0);
-  a167=arg[0]? arg[0][171] : 0;
-  a167=(a166?a167:0);
-  a024=(a024+a167);
+  a022=arg[0]? arg[0][171] : 0;
+  a168=(a166?a022:0);
+  a024=(a024+a168);
   if (res[0]!=0) res[0][171]=a024;
   a026=(a164?a026:0);
-  a167=arg[0]? arg[0][172] : 0;
-  a167=(a166?a167:0);
-  a026=(a026+a167);
+  a024=arg[0]? arg[0][172] : 0;
+  a168=(a166?a024:0);
+  a026=(a026+a168);
   if (res[0]!=0) res[0][172]=a026;
   a028=(a164?a028:0);
-  a167=arg[0]? arg[0][173] : 0;
-  a167=(a166?a167:0);
-  a028=(a028+a167);
+  a026=arg[0]? arg[0][173] : 0;
+  a168=(a166?a026:0);
+  a028=(a028+a168);
   if (res[0]!=0) res[0][173]=a028;
   a030=(a164?a030:0);
-  a167=arg[0]? arg[0][174] : 0;
-  a167=(a166?a167:0);
-  a030=(a030+a167);
+  a028=arg[0]? arg[0][174] : 0;
+  a168=(a166?a028:0);
+  a030=(a030+a168);
   if (res[0]!=0) res[0][174]=a030;
   a032=(a164?a032:0);
-  a167=arg[0]? arg[0][175] : 0;
-  a167=(a166?a167:0);
-  a032=(a032+a167);
+  a030=arg[0]? arg[0][175] : 0;
+  a168=(a166?a030:0);
+  a032=(a032+a168);
   if (res[0]!=0) res[0][175]=a032;
   a034=(a164?a034:0);
-  a167=arg[0]? arg[0][176] : 0;
-  a167=(a166?a167:0);
-  a034=(a034+a167);
+  a032=arg[0]? arg[0][176] : 0;
+  a168=(a166?a032:0);
+  a034=(a034+a168);
   if (res[0]!=0) res[0][176]=a034;
   a036=(a164?a036:0);
-  a167=arg[0]? arg[0][177] : 0;
-  a167=(a166?a167:0);
-  a036=(a036+a167);
+  a034=arg[0]? arg[0][177] : 0;
+  a168=(a166?a034:0);
+  a036=(a036+a168);
   if (res[0]!=0) res[0][177]=a036;
   a038=(a164?a038:0);
-  a167=arg[0]? arg[0][178] : 0;
-  a167=(a166?a167:0);
-  a038=(a038+a167);
+  a036=arg[0]? arg[0][178] : 0;
+  a168=(a166?a036:0);
+  a038=(a038+a168);
   if (res[0]!=0) res[0][178]=a038;
   a040=(a164?a040:0);
-  a167=arg[0]? arg[0][179] : 0;
-  a167=(a166?a167:0);
-  a040=(a040+a167);
+  a038=arg[0]? arg[0][179] : 0;
+  a168=(a166?a038:0);
+  a040=(a040+a168);
   if (res[0]!=0) res[0][179]=a040;
   a042=(a164?a042:0);
-  a167=arg[0]? arg[0][180] : 0;
-  a167=(a166?a167:0);
-  a042=(a042+a167);
+  a040=arg[0]? arg[0][180] : 0;
+  a168=(a166?a040:0);
+  a042=(a042+a168);
   if (res[0]!=0) res[0][180]=a042;
   a044=(a164?a044:0);
-  a167=arg[0]? arg[0][181] : 0;
-  a167=(a166?a167:0);
-  a044=(a044+a167);
+  a042=arg[0]? arg[0][181] : 0;
+  a168=(a166?a042:0);
+  a044=(a044+a168);
   if (res[0]!=0) res[0][181]=a044;
   a046=(a164?a046:0);
-  a167=arg[0]? arg[0][182] : 0;
-  a167=(a166?a167:0);
-  a046=(a046+a167);
+  a044=arg[0]? arg[0][182] : 0;
+  a168=(a166?a044:0);
+  a046=(a046+a168);
   if (res[0]!=0) res[0][182]=a046;
   a048=(a164?a048:0);
-  a167=arg[0]? arg[0][183] : 0;
-  a167=(a166?a167:0);
-  a048=(a048+a167);
+  a046=arg[0]? arg[0][183] : 0;
+  a168=(a166?a046:0);
+  a048=(a048+a168);
   if (res[0]!=0) res[0][183]=a048;
   a050=(a164?a050:0);
-  a167=arg[0]? arg[0][184] : 0;
-  a167=(a166?a167:0);
-  a050=(a050+a167);
+  a048=arg[0]? arg[0][184] : 0;
+  a168=(a166?a048:0);
+  a050=(a050+a168);
   if (res[0]!=0) res[0][184]=a050;
   a052=(a164?a052:0);
-  a167=arg[0]? arg[0][185] : 0;
-  a167=(a166?a167:0);
-  a052=(a052+a167);
+  a050=arg[0]? arg[0][185] : 0;
+  a168=(a166?a050:0);
+  a052=(a052+a168);
   if (res[0]!=0) res[0][185]=a052;
   a054=(a164?a054:0);
-  a167=arg[0]? arg[0][186] : 0;
-  a167=(a166?a167:0);
-  a054=(a054+a167);
+  a052=arg[0]? arg[0][186] : 0;
+  a168=(a166?a052:0);
+  a054=(a054+a168);
   if (res[0]!=0) res[0][186]=a054;
   a056=(a164?a056:0);
-  a167=arg[0]? arg[0][187] : 0;
-  a167=(a166?a167:0);
-  a056=(a056+a167);
+  a054=arg[0]? arg[0][187] : 0;
+  a168=(a166?a054:0);
+  a056=(a056+a168);
   if (res[0]!=0) res[0][187]=a056;
   a058=(a164?a058:0);
-  a167=arg[0]? arg[0][188] : 0;
-  a167=(a166?a167:0);
-  a058=(a058+a167);
+  a056=arg[0]? arg[0][188] : 0;
+  a168=(a166?a056:0);
+  a058=(a058+a168);
   if (res[0]!=0) res[0][188]=a058;
   a060=(a164?a060:0);
-  a167=arg[0]? arg[0][189] : 0;
-  a167=(a166?a167:0);
-  a060=(a060+a167);
+  a058=arg[0]? arg[0][189] : 0;
+  a168=(a166?a058:0);
+  a060=(a060+a168);
   if (res[0]!=0) res[0][189]=a060;
   a062=(a164?a062:0);
-  a167=arg[0]? arg[0][190] : 0;
-  a167=(a166?a167:0);
-  a062=(a062+a167);
+  a060=arg[0]? arg[0][190] : 0;
+  a168=(a166?a060:0);
+  a062=(a062+a168);
   if (res[0]!=0) res[0][190]=a062;
   a064=(a164?a064:0);
-  a167=arg[0]? arg[0][191] : 0;
-  a167=(a166?a167:0);
-  a064=(a064+a167);
+  a062=arg[0]? arg[0][191] : 0;
+  a168=(a166?a062:0);
+  a064=(a064+a168);
   if (res[0]!=0) res[0][191]=a064;
   a066=(a164?a066:0);
-  a167=arg[0]? arg[0][192] : 0;
-  a167=(a166?a167:0);
-  a066=(a066+a167);
+  a064=arg[0]? arg[0][192] : 0;
+  a168=(a166?a064:0);
+  a066=(a066+a168);
   if (res[0]!=0) res[0][192]=a066;
   a068=(a164?a068:0);
-  a167=arg[0]? arg[0][193] : 0;
-  a167=(a166?a167:0);
-  a068=(a068+a167);
+  a066=arg[0]? arg[0][193] : 0;
+  a168=(a166?a066:0);
+  a068=(a068+a168);
   if (res[0]!=0) res[0][193]=a068;
   a070=(a164?a070:0);
-  a167=arg[0]? arg[0][194] : 0;
-  a167=(a166?a167:0);
-  a070=(a070+a167);
+  a068=arg[0]? arg[0][194] : 0;
+  a168=(a166?a068:0);
+  a070=(a070+a168);
   if (res[0]!=0) res[0][194]=a070;
   a072=(a164?a072:0);
-  a167=arg[0]? arg[0][195] : 0;
-  a167=(a166?a167:0);
-  a072=(a072+a167);
+  a070=arg[0]? arg[0][195] : 0;
+  a168=(a166?a070:0);
+  a072=(a072+a168);
   if (res[0]!=0) res[0][195]=a072;
   a074=(a164?a074:0);
-  a167=arg[0]? arg[0][196] : 0;
-  a167=(a166?a167:0);
-  a074=(a074+a167);
+  a072=arg[0]? arg[0][196] : 0;
+  a168=(a166?a072:0);
+  a074=(a074+a168);
   if (res[0]!=0) res[0][196]=a074;
   a076=(a164?a076:0);
-  a167=arg[0]? arg[0][197] : 0;
-  a167=(a166?a167:0);
-  a076=(a076+a167);
+  a074=arg[0]? arg[0][197] : 0;
+  a168=(a166?a074:0);
+  a076=(a076+a168);
   if (res[0]!=0) res[0][197]=a076;
   a078=(a164?a078:0);
-  a167=arg[0]? arg[0][198] : 0;
-  a167=(a166?a167:0);
-  a078=(a078+a167);
+  a076=arg[0]? arg[0][198] : 0;
+  a168=(a166?a076:0);
+  a078=(a078+a168);
   if (res[0]!=0) res[0][198]=a078;
   a080=(a164?a080:0);
-  a167=arg[0]? arg[0][199] : 0;
-  a167=(a166?a167:0);
-  a080=(a080+a167);
+  a078=arg[0]? arg[0][199] : 0;
+  a168=(a166?a078:0);
+  a080=(a080+a168);
   if (res[0]!=0) res[0][199]=a080;
   a082=(a164?a082:0);
-  a167=arg[0]? arg[0][200] : 0;
-  a167=(a166?a167:0);
-  a082=(a082+a167);
+  a080=arg[0]? arg[0][200] : 0;
+  a168=(a166?a080:0);
+  a082=(a082+a168);
   if (res[0]!=0) res[0][200]=a082;
   a084=(a164?a084:0);
-  a167=arg[0]? arg[0][201] : 0;
-  a167=(a166?a167:0);
-  a084=(a084+a167);
+  a082=arg[0]? arg[0][201] : 0;
+  a168=(a166?a082:0);
+  a084=(a084+a168);
   if (res[0]!=0) res[0][201]=a084;
   a086=(a164?a086:0);
-  a167=arg[0]? arg[0][202] : 0;
-  a167=(a166?a167:0);
-  a086=(a086+a167);
+  a084=arg[0]? arg[0][202] : 0;
+  a168=(a166?a084:0);
+  a086=(a086+a168);
   if (res[0]!=0) res[0][202]=a086;
   a088=(a164?a088:0);
-  a167=arg[0]? arg[0][203] : 0;
-  a167=(a166?a167:0);
-  a088=(a088+a167);
+  a086=arg[0]? arg[0][203] : 0;
+  a168=(a166?a086:0);
+  a088=(a088+a168);
   if (res[0]!=0) res[0][203]=a088;
   a090=(a164?a090:0);
-  a167=arg[0]? arg[0][204] : 0;
-  a167=(a166?a167:0);
-  a090=(a090+a167);
+  a088=arg[0]? arg[0][204] : 0;
+  a168=(a166?a088:0);
+  a090=(a090+a168);
   if (res[0]!=0) res[0][204]=a090;
   a092=(a164?a092:0);
-  a167=arg[0]? arg[0][205] : 0;
-  a167=(a166?a167:0);
-  a092=(a092+a167);
+  a090=arg[0]? arg[0][205] : 0;
+  a168=(a166?a090:0);
+  a092=(a092+a168);
   if (res[0]!=0) res[0][205]=a092;
   a094=(a164?a094:0);
-  a167=arg[0]? arg[0][206] : 0;
-  a167=(a166?a167:0);
-  a094=(a094+a167);
+  a092=arg[0]? arg[0][206] : 0;
+  a168=(a166?a092:0);
+  a094=(a094+a168);
   if (res[0]!=0) res[0][206]=a094;
   a096=(a164?a096:0);
-  a167=arg[0]? arg[0][207] : 0;
-  a167=(a166?a167:0);
-  a096=(a096+a167);
+  a094=arg[0]? arg[0][207] : 0;
+  a168=(a166?a094:0);
+  a096=(a096+a168);
   if (res[0]!=0) res[0][207]=a096;
   a098=(a164?a098:0);
-  a167=arg[0]? arg[0][208] : 0;
-  a167=(a166?a167:0);
-  a098=(a098+a167);
+  a096=arg[0]? arg[0][208] : 0;
+  a168=(a166?a096:0);
+  a098=(a098+a168);
   if (res[0]!=0) res[0][208]=a098;
   a100=(a164?a100:0);
-  a167=arg[0]? arg[0][209] : 0;
-  a167=(a166?a167:0);
-  a100=(a100+a167);
+  a098=arg[0]? arg[0][209] : 0;
+  a168=(a166?a098:0);
+  a100=(a100+a168);
   if (res[0]!=0) res[0][209]=a100;
   a102=(a164?a102:0);
-  a167=arg[0]? arg[0][210] : 0;
-  a167=(a166?a167:0);
-  a102=(a102+a167);
+  a100=arg[0]? arg[0][210] : 0;
+  a168=(a166?a100:0);
+  a102=(a102+a168);
   if (res[0]!=0) res[0][210]=a102;
   a104=(a164?a104:0);
-  a167=arg[0]? arg[0][211] : 0;
-  a167=(a166?a167:0);
-  a104=(a104+a167);
+  a102=arg[0]? arg[0][211] : 0;
+  a168=(a166?a102:0);
+  a104=(a104+a168);
   if (res[0]!=0) res[0][211]=a104;
   a106=(a164?a106:0);
-  a167=arg[0]? arg[0][212] : 0;
-  a167=(a166?a167:0);
-  a106=(a106+a167);
+  a104=arg[0]? arg[0][212] : 0;
+  a168=(a166?a104:0);
+  a106=(a106+a168);
   if (res[0]!=0) res[0][212]=a106;
   a108=(a164?a108:0);
-  a167=arg[0]? arg[0][213] : 0;
-  a167=(a166?a167:0);
-  a108=(a108+a167);
+  a106=arg[0]? arg[0][213] : 0;
+  a168=(a166?a106:0);
+  a108=(a108+a168);
   if (res[0]!=0) res[0][213]=a108;
   a110=(a164?a110:0);
-  a167=arg[0]? arg[0][214] : 0;
-  a167=(a166?a167:0);
-  a110=(a110+a167);
+  a108=arg[0]? arg[0][214] : 0;
+  a168=(a166?a108:0);
+  a110=(a110+a168);
   if (res[0]!=0) res[0][214]=a110;
   a112=(a164?a112:0);
-  a167=arg[0]? arg[0][215] : 0;
-  a167=(a166?a167:0);
-  a112=(a112+a167);
+  a110=arg[0]? arg[0][215] : 0;
+  a168=(a166?a110:0);
+  a112=(a112+a168);
   if (res[0]!=0) res[0][215]=a112;
   a114=(a164?a114:0);
-  a167=arg[0]? arg[0][216] : 0;
-  a167=(a166?a167:0);
-  a114=(a114+a167);
+  a112=arg[0]? arg[0][216] : 0;
+  a168=(a166?a112:0);
+  a114=(a114+a168);
   if (res[0]!=0) res[0][216]=a114;
   a116=(a164?a116:0);
-  a167=arg[0]? arg[0][217] : 0;
-  a167=(a166?a167:0);
-  a116=(a116+a167);
+  a114=arg[0]? arg[0][217] : 0;
+  a168=(a166?a114:0);
+  a116=(a116+a168);
   if (res[0]!=0) res[0][217]=a116;
   a118=(a164?a118:0);
-  a167=arg[0]? arg[0][218] : 0;
-  a167=(a166?a167:0);
-  a118=(a118+a167);
+  a116=arg[0]? arg[0][218] : 0;
+  a168=(a166?a116:0);
+  a118=(a118+a168);
   if (res[0]!=0) res[0][218]=a118;
   a120=(a164?a120:0);
-  a167=arg[0]? arg[0][219] : 0;
-  a167=(a166?a167:0);
-  a120=(a120+a167);
+  a118=arg[0]? arg[0][219] : 0;
+  a168=(a166?a118:0);
+  a120=(a120+a168);
   if (res[0]!=0) res[0][219]=a120;
   a122=(a164?a122:0);
-  a167=arg[0]? arg[0][220] : 0;
-  a167=(a166?a167:0);
-  a122=(a122+a167);
+  a120=arg[0]? arg[0][220] : 0;
+  a168=(a166?a120:0);
+  a122=(a122+a168);
   if (res[0]!=0) res[0][220]=a122;
   a124=(a164?a124:0);
-  a167=arg[0]? arg[0][221] : 0;
-  a167=(a166?a167:0);
-  a124=(a124+a167);
+  a122=arg[0]? arg[0][221] : 0;
+  a168=(a166?a122:0);
+  a124=(a124+a168);
   if (res[0]!=0) res[0][221]=a124;
   a126=(a164?a126:0);
-  a167=arg[0]? arg[0][222] : 0;
-  a167=(a166?a167:0);
-  a126=(a126+a167);
+  a124=arg[0]? arg[0][222] : 0;
+  a168=(a166?a124:0);
+  a126=(a126+a168);
   if (res[0]!=0) res[0][222]=a126;
   a128=(a164?a128:0);
-  a167=arg[0]? arg[0][223] : 0;
-  a167=(a166?a167:0);
-  a128=(a128+a167);
+  a126=arg[0]? arg[0][223] : 0;
+  a168=(a166?a126:0);
+  a128=(a128+a168);
   if (res[0]!=0) res[0][223]=a128;
   a130=(a164?a130:0);
-  a167=arg[0]? arg[0][224] : 0;
-  a167=(a166?a167:0);
-  a130=(a130+a167);
+  a128=arg[0]? arg[0][224] : 0;
+  a168=(a166?a128:0);
+  a130=(a130+a168);
   if (res[0]!=0) res[0][224]=a130;
   a132=(a164?a132:0);
-  a167=arg[0]? arg[0][225] : 0;
-  a167=(a166?a167:0);
-  a132=(a132+a167);
+  a130=arg[0]? arg[0][225] : 0;
+  a168=(a166?a130:0);
+  a132=(a132+a168);
   if (res[0]!=0) res[0][225]=a132;
   a134=(a164?a134:0);
-  a167=arg[0]? arg[0][226] : 0;
-  a167=(a166?a167:0);
-  a134=(a134+a167);
+  a132=arg[0]? arg[0][226] : 0;
+  a168=(a166?a132:0);
+  a134=(a134+a168);
   if (res[0]!=0) res[0][226]=a134;
   a136=(a164?a136:0);
-  a167=arg[0]? arg[0][227] : 0;
-  a167=(a166?a167:0);
-  a136=(a136+a167);
+  a134=arg[0]? arg[0][227] : 0;
+  a168=(a166?a134:0);
+  a136=(a136+a168);
   if (res[0]!=0) res[0][227]=a136;
   a138=(a164?a138:0);
-  a167=arg[0]? arg[0][228] : 0;
-  a167=(a166?a167:0);
-  a138=(a138+a167);
+  a136=arg[0]? arg[0][228] : 0;
+  a168=(a166?a136:0);
+  a138=(a138+a168);
   if (res[0]!=0) res[0][228]=a138;
   a140=(a164?a140:0);
-  a167=arg[0]? arg[0][229] : 0;
-  a166=(a166?a167:0);
+  a138=arg[0]? arg[0][229] : 0;
+  a166=(a166?a138:0);
   a140=(a140+a166);
   if (res[0]!=0) res[0][229]=a140;
   a163=(a163||a165);
-  a166=arg[0]? arg[0][232] : 0;
-  a167=3.;
+  a140=arg[0]? arg[0][232] : 0;
+  a166=3.;
   a168=arg[3]? arg[3][2] : 0;
   a169=20.;
   a170=arg[0]? arg[0][233] : 0;
@@ -1234,185 +1261,187 @@ static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a168=(a168<a172);
   a162=arg[0]? arg[0][234] : 0;
   a162=(a162+a171);
-  a162=casadi_fmin(a162,a167);
+  a162=casadi_fmin(a162,a166);
   a168=(a168?a162:0);
-  a167=(a167<=a168);
-  a162=(a163&&a167);
-  a164=(!a164);
-  a001=arg[0]? arg[0][231] : 0;
-  a001=(a001+a171);
-  a164=(a164?a001:0);
-  a001=10.;
-  a171=(a164<=a001);
+  a166=(a166<=a168);
+  a162=(a163&&a166);
+  a001=(!a164);
+  a173=arg[0]? arg[0][231] : 0;
+  a173=(a173+a171);
+  a001=(a001?a173:0);
+  a173=10.;
+  a171=(a001<=a173);
   a162=(a162&&a171);
-  a166=(a166||a162);
-  a162=(!a166);
+  a140=(a140||a162);
+  a162=(!a140);
   a162=(a163&&a162);
-  a001=(a001<=a164);
-  a162=(a162&&a001);
-  a001=(!a162);
-  a001=(a163&&a001);
-  if (res[0]!=0) res[0][230]=a001;
-  a163=(a163?a164:0);
+  a173=(a173<=a001);
+  a162=(a162&&a173);
+  a173=(!a162);
+  a173=(a163&&a173);
+  if (res[0]!=0) res[0][230]=a173;
+  a163=(a163?a001:0);
   if (res[0]!=0) res[0][231]=a163;
-  if (res[0]!=0) res[0][232]=a166;
+  if (res[0]!=0) res[0][232]=a140;
   if (res[0]!=0) res[0][233]=a170;
   if (res[0]!=0) res[0][234]=a168;
   a168=(a143+a003);
   if (res[1]!=0) res[1][0]=a168;
-  a000=(a000*a002);
-  a004=(a004*a005);
-  a000=(a000+a004);
-  a006=(a006*a007);
-  a000=(a000+a006);
-  a008=(a008*a009);
-  a000=(a000+a008);
-  a010=(a010*a011);
-  a000=(a000+a010);
-  a012=(a012*a013);
-  a000=(a000+a012);
-  a014=(a014*a015);
-  a000=(a000+a014);
-  a016=(a016*a017);
-  a000=(a000+a016);
-  a018=(a018*a019);
-  a000=(a000+a018);
-  a020=(a020*a021);
-  a000=(a000+a020);
-  a022=(a022*a023);
-  a000=(a000+a022);
-  a024=(a024*a025);
-  a000=(a000+a024);
-  a026=(a026*a027);
-  a000=(a000+a026);
-  a028=(a028*a029);
-  a000=(a000+a028);
-  a030=(a030*a031);
-  a000=(a000+a030);
-  a032=(a032*a033);
-  a000=(a000+a032);
-  a034=(a034*a035);
-  a000=(a000+a034);
-  a036=(a036*a037);
-  a000=(a000+a036);
-  a038=(a038*a039);
-  a000=(a000+a038);
-  a040=(a040*a041);
-  a000=(a000+a040);
-  a042=(a042*a043);
-  a000=(a000+a042);
-  a044=(a044*a045);
-  a000=(a000+a044);
-  a046=(a046*a047);
-  a000=(a000+a046);
-  a048=(a048*a049);
-  a000=(a000+a048);
-  a050=(a050*a051);
-  a000=(a000+a050);
-  a052=(a052*a053);
-  a000=(a000+a052);
-  a054=(a054*a055);
-  a000=(a000+a054);
-  a056=(a056*a057);
-  a000=(a000+a056);
-  a058=(a058*a059);
-  a000=(a000+a058);
-  a060=(a060*a061);
-  a000=(a000+a060);
-  a062=(a062*a063);
-  a000=(a000+a062);
-  a064=(a064*a065);
-  a000=(a000+a064);
-  a066=(a066*a067);
-  a000=(a000+a066);
-  a068=(a068*a069);
-  a000=(a000+a068);
-  a070=(a070*a071);
-  a000=(a000+a070);
-  a072=(a072*a073);
-  a000=(a000+a072);
-  a074=(a074*a075);
-  a000=(a000+a074);
-  a076=(a076*a077);
-  a000=(a000+a076);
-  a078=(a078*a079);
-  a000=(a000+a078);
-  a080=(a080*a081);
-  a000=(a000+a080);
-  a082=(a082*a083);
-  a000=(a000+a082);
-  a084=(a084*a085);
-  a000=(a000+a084);
-  a086=(a086*a087);
-  a000=(a000+a086);
-  a088=(a088*a089);
-  a000=(a000+a088);
-  a090=(a090*a091);
-  a000=(a000+a090);
-  a092=(a092*a093);
-  a000=(a000+a092);
-  a094=(a094*a095);
-  a000=(a000+a094);
-  a096=(a096*a097);
-  a000=(a000+a096);
-  a098=(a098*a099);
-  a000=(a000+a098);
-  a100=(a100*a101);
-  a000=(a000+a100);
-  a102=(a102*a103);
-  a000=(a000+a102);
-  a104=(a104*a105);
-  a000=(a000+a104);
-  a106=(a106*a107);
-  a000=(a000+a106);
-  a108=(a108*a109);
-  a000=(a000+a108);
-  a110=(a110*a111);
-  a000=(a000+a110);
-  a112=(a112*a113);
-  a000=(a000+a112);
-  a114=(a114*a115);
-  a000=(a000+a114);
-  a116=(a116*a117);
-  a000=(a000+a116);
-  a118=(a118*a119);
-  a000=(a000+a118);
-  a120=(a120*a121);
-  a000=(a000+a120);
-  a122=(a122*a123);
-  a000=(a000+a122);
-  a124=(a124*a125);
-  a000=(a000+a124);
-  a126=(a126*a127);
-  a000=(a000+a126);
-  a128=(a128*a129);
-  a000=(a000+a128);
-  a130=(a130*a131);
-  a000=(a000+a130);
-  a132=(a132*a133);
-  a000=(a000+a132);
-  a134=(a134*a135);
-  a000=(a000+a134);
-  a136=(a136*a137);
-  a000=(a000+a136);
-  a138=(a138*a139);
-  a000=(a000+a138);
-  a140=(a140*a141);
-  a000=(a000+a140);
-  a000=(a001?a000:0);
-  a140=(!a001);
-  a140=(a140?a003:0);
-  a000=(a000+a140);
-  a143=(a143+a000);
+  a164=(!a164);
+  a164=(a173&&a164);
+  a167=(a167*a002);
+  a000=(a000*a005);
+  a167=(a167+a000);
+  a004=(a004*a007);
+  a167=(a167+a004);
+  a006=(a006*a009);
+  a167=(a167+a006);
+  a008=(a008*a011);
+  a167=(a167+a008);
+  a010=(a010*a013);
+  a167=(a167+a010);
+  a012=(a012*a015);
+  a167=(a167+a012);
+  a014=(a014*a017);
+  a167=(a167+a014);
+  a016=(a016*a019);
+  a167=(a167+a016);
+  a018=(a018*a021);
+  a167=(a167+a018);
+  a020=(a020*a023);
+  a167=(a167+a020);
+  a022=(a022*a025);
+  a167=(a167+a022);
+  a024=(a024*a027);
+  a167=(a167+a024);
+  a026=(a026*a029);
+  a167=(a167+a026);
+  a028=(a028*a031);
+  a167=(a167+a028);
+  a030=(a030*a033);
+  a167=(a167+a030);
+  a032=(a032*a035);
+  a167=(a167+a032);
+  a034=(a034*a037);
+  a167=(a167+a034);
+  a036=(a036*a039);
+  a167=(a167+a036);
+  a038=(a038*a041);
+  a167=(a167+a038);
+  a040=(a040*a043);
+  a167=(a167+a040);
+  a042=(a042*a045);
+  a167=(a167+a042);
+  a044=(a044*a047);
+  a167=(a167+a044);
+  a046=(a046*a049);
+  a167=(a167+a046);
+  a048=(a048*a051);
+  a167=(a167+a048);
+  a050=(a050*a053);
+  a167=(a167+a050);
+  a052=(a052*a055);
+  a167=(a167+a052);
+  a054=(a054*a057);
+  a167=(a167+a054);
+  a056=(a056*a059);
+  a167=(a167+a056);
+  a058=(a058*a061);
+  a167=(a167+a058);
+  a060=(a060*a063);
+  a167=(a167+a060);
+  a062=(a062*a065);
+  a167=(a167+a062);
+  a064=(a064*a067);
+  a167=(a167+a064);
+  a066=(a066*a069);
+  a167=(a167+a066);
+  a068=(a068*a071);
+  a167=(a167+a068);
+  a070=(a070*a073);
+  a167=(a167+a070);
+  a072=(a072*a075);
+  a167=(a167+a072);
+  a074=(a074*a077);
+  a167=(a167+a074);
+  a076=(a076*a079);
+  a167=(a167+a076);
+  a078=(a078*a081);
+  a167=(a167+a078);
+  a080=(a080*a083);
+  a167=(a167+a080);
+  a082=(a082*a085);
+  a167=(a167+a082);
+  a084=(a084*a087);
+  a167=(a167+a084);
+  a086=(a086*a089);
+  a167=(a167+a086);
+  a088=(a088*a091);
+  a167=(a167+a088);
+  a090=(a090*a093);
+  a167=(a167+a090);
+  a092=(a092*a095);
+  a167=(a167+a092);
+  a094=(a094*a097);
+  a167=(a167+a094);
+  a096=(a096*a099);
+  a167=(a167+a096);
+  a098=(a098*a101);
+  a167=(a167+a098);
+  a100=(a100*a103);
+  a167=(a167+a100);
+  a102=(a102*a105);
+  a167=(a167+a102);
+  a104=(a104*a107);
+  a167=(a167+a104);
+  a106=(a106*a109);
+  a167=(a167+a106);
+  a108=(a108*a111);
+  a167=(a167+a108);
+  a110=(a110*a113);
+  a167=(a167+a110);
+  a112=(a112*a115);
+  a167=(a167+a112);
+  a114=(a114*a117);
+  a167=(a167+a114);
+  a116=(a116*a119);
+  a167=(a167+a116);
+  a118=(a118*a121);
+  a167=(a167+a118);
+  a120=(a120*a123);
+  a167=(a167+a120);
+  a122=(a122*a125);
+  a167=(a167+a122);
+  a124=(a124*a127);
+  a167=(a167+a124);
+  a126=(a126*a129);
+  a167=(a167+a126);
+  a128=(a128*a131);
+  a167=(a167+a128);
+  a130=(a130*a133);
+  a167=(a167+a130);
+  a132=(a132*a135);
+  a167=(a167+a132);
+  a134=(a134*a137);
+  a167=(a167+a134);
+  a136=(a136*a139);
+  a167=(a167+a136);
+  a138=(a138*a141);
+  a167=(a167+a138);
+  a167=(a164?a167:0);
+  a164=(!a164);
+  a164=(a164?a003:0);
+  a167=(a167+a164);
+  a143=(a143+a167);
   if (res[1]!=0) res[1][1]=a143;
   if (res[1]!=0) res[1][2]=a142;
   a142=casadi_sq(a142);
   if (res[1]!=0) res[1][3]=a142;
   if (res[1]!=0) res[1][4]=a172;
   if (res[1]!=0) res[1][5]=a165;
-  if (res[1]!=0) res[1][6]=a167;
-  if (res[1]!=0) res[1][7]=a001;
-  if (res[1]!=0) res[1][8]=a166;
+  if (res[1]!=0) res[1][6]=a166;
+  if (res[1]!=0) res[1][7]=a173;
+  if (res[1]!=0) res[1][8]=a140;
   if (res[1]!=0) res[1][9]=a162;
   return 0;
 }
@@ -1495,6 +1524,136 @@ CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_step_work_bytes(casadi_
   if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
   if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* uvsym_sensor_fdi_lms_casadi_lms_fir_step:(C[70],U[70],target,u,mu)->(C_next[70],U_next[70],d,e) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  (void)iw; (void)w; (void)mem;
+  casadi_int i;
+  casadi_real *rr, *w0=w+0, w1, w3, w4, *w5=w+70;
+  const casadi_real *cr, *cs, *wr0, *wr2, *wr6;
+  /* #0: @0 = input[0][0] */
+  wr0 = arg[0] ? arg[0] : casadi_zeros;
+  /* #1: @1 = input[4][0] */
+  w1 = arg[4] ? arg[4][0] : 0;
+  /* #2: @1 = (2.*@1) */
+  w1 = (2.* w1 );
+  /* #3: @2 = input[1][0] */
+  wr2 = arg[1] ? arg[1] : casadi_zeros;
+  /* #4: @3 = dot(@0, @2) */
+  w3 = casadi_dot(70, wr0, wr2);
+  /* #5: @4 = input[2][0] */
+  w4 = arg[2] ? arg[2][0] : 0;
+  /* #6: @4 = (@3-@4) */
+  w4  = (w3-w4);
+  /* #7: @1 = (@1*@4) */
+  w1 *= w4;
+  /* #8: @5 = (@1*@2) */
+  for (i=0, rr=w5, cs=wr2; i<70; ++i) (*rr++)  = (w1*(*cs++));
+  /* #9: @0 = (@0-@5) */
+  for (i=0, rr=w0, cr=wr0, cs=w5; i<70; ++i) (*rr++)  = ((*cr++)-(*cs++));
+  /* #10: output[0][0] = @0 */
+  casadi_copy(w0, 70, res[0]);
+  /* #11: @1 = input[3][0] */
+  w1 = arg[3] ? arg[3][0] : 0;
+  /* #12: output[1][0] = @1 */
+  if (res[1]) res[1][0] = w1;
+  /* #13: @6 = @2[:69] */
+  wr6 = wr2+0;
+  /* #14: output[1][1] = @6 */
+  if (res[1]) casadi_copy(wr6, 69, res[1]+1);
+  /* #15: output[2][0] = @3 */
+  if (res[2]) res[2][0] = w3;
+  /* #16: output[3][0] = @4 */
+  if (res[3]) res[3][0] = w4;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  (void)iw; (void)w; (void)mem;
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void uvsym_sensor_fdi_lms_casadi_lms_fir_step_release(int mem) {
+  (void)mem;
+}
+
+CASADI_SYMBOL_EXPORT void uvsym_sensor_fdi_lms_casadi_lms_fir_step_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void uvsym_sensor_fdi_lms_casadi_lms_fir_step_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int uvsym_sensor_fdi_lms_casadi_lms_fir_step_n_in(void) { return 5;}
+
+CASADI_SYMBOL_EXPORT casadi_int uvsym_sensor_fdi_lms_casadi_lms_fir_step_n_out(void) { return 4;}
+
+CASADI_SYMBOL_EXPORT casadi_real uvsym_sensor_fdi_lms_casadi_lms_fir_step_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* uvsym_sensor_fdi_lms_casadi_lms_fir_step_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "C";
+    case 1: return "U";
+    case 2: return "target";
+    case 3: return "u";
+    case 4: return "mu";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* uvsym_sensor_fdi_lms_casadi_lms_fir_step_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "C_next";
+    case 1: return "U_next";
+    case 2: return "d";
+    case 3: return "e";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_sensor_fdi_lms_casadi_lms_fir_step_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s5;
+    case 2: return casadi_s1;
+    case 3: return casadi_s1;
+    case 4: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* uvsym_sensor_fdi_lms_casadi_lms_fir_step_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s5;
+    case 2: return casadi_s1;
+    case 3: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 7;
+  if (sz_res) *sz_res = 5;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 140;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 7*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 5*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 140*sizeof(casadi_real);
   return 0;
 }
 
