@@ -96,6 +96,7 @@ def build(out_dir: Path, progress) -> None:
         "enclosure_violations": enclosure["violations"], "enclosure_samples": enclosure["samples"],
         "enclosure_lp_checked": enclosure["lp_checked"],
         "unobservable_eigenvalue_angle_only": refuted[0].counterexample["unobservable_eigenvalue"] if refuted else None,
+        "max_abs_M": {obs.name: float(np.max(np.abs(item.M))) for obs, item in zip(d.bank.observers, d.bank.designs)},
         "band_half_width_final": {obs.name: dict(zip(d.plant.x.names, ((b.upper[-1] - b.lower[-1]) / 2).tolist()))
                                   for obs, b in zip(d.bank.observers, d.bands)},
         "figures": {"fig1": fig1, "fig2": fig2},
@@ -178,7 +179,8 @@ stated, and computed by the run that wrote this report.
   observer's design.
 - Measurements: all eight states, y = x + v with |v| bounded by: {noise} (angles: half an encoder
   count of the Quanser rig). The paper's y = (theta, phi, psi) is refuted below.
-- Observer i decouples [D1, B_i]: T = I - Q C, Q = [D1 B_i] (C [D1 B_i])^+, F = T G - K1 C with
+- Observer i decouples [D1, B_i]: T = I - Q C, Q = [D1 B_i] M, M = (C [D1 B_i])^+ (largest |M| entry
+  {max(r['max_abs_M'].values()):.4g}), F = T G - K1 C with
   F's eigenvalues placed at {", ".join(f"{p:.3g}" for p in POLES)} (scipy place_poles), J = T H,
   K = K1 + F Q, xhat = z + Q y.
 - Bands: the joint zonotope of (e_k, v_k) with e_0 in the box |e_0| <= {ERROR_BOUND:g} (the observers start

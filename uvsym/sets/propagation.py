@@ -84,7 +84,7 @@ def propagate(A, C, initial: Zonotope, noise: Zonotope, steps: int, generators: 
         outputs.append(out)
         lower[k], upper[k] = out.interval_hull()
         exact[k] = noise_radius + np.sum(np.abs(C @ power @ initial.generators), axis=1)
-        if np.any(upper[k] - out.center > growth_limit * exact[k] + 1e-300):
+        if np.any(upper[k] - out.center > growth_limit * exact[k] + 1e-12 * max(exact[k].max(), 1e-300)):
             worst = int(np.argmax((upper[k] - out.center) / np.maximum(exact[k], 1e-300)))
             raise SetDivergenceError(f"the enclosure grows: at step {k}, output {worst}'s hull radius "
                                      f"{upper[k, worst] - out.center[worst]:.3g} exceeds {growth_limit:g} times the "
