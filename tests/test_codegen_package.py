@@ -204,6 +204,9 @@ def test_finite_check_codes_and_the_option_to_leave_it_out(tmp_path):
     assert "isfinite" not in (tmp_path / "off" / "src" / "tiny.c").read_text()
     manifest = json.loads((tmp_path / "off" / "manifest.json").read_text())
     assert not manifest["finite_check"] and "TINY_NONFINITE_INPUT" not in manifest["return_codes"]
+    assert main(["codegen", "motor-luenberger", "--no-finite-check", "-o", str(tmp_path / "cli")]) == 0
+    assert not json.loads((tmp_path / "cli" / "manifest.json").read_text())["finite_check"]
+    assert "isfinite" not in (tmp_path / "cli" / "src" / "uvsym_induction_motor.c").read_text()
 
 
 def _stiff(made, factor: float) -> Example:
