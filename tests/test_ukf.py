@@ -51,10 +51,12 @@ def data():
     return rng.normal(size=(150, 2)), rng.normal(size=(150, 1))
 
 
+@pytest.mark.parametrize("closed_form", [True, False])
 @pytest.mark.parametrize("alpha, beta, kappa", [(1.0, 2.0, 0.0), (0.5, 2.0, 1.0), (0.1, 0.0, 0.0)])
-def test_ukf_is_the_kalman_filter_on_a_linear_gaussian_system(data, alpha, beta, kappa):
+def test_ukf_is_the_kalman_filter_on_a_linear_gaussian_system(data, alpha, beta, kappa, closed_form):
     Y, U = data
-    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, x0=X0, alpha=alpha, beta=beta, kappa=kappa)
+    obs = ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, x0=X0, alpha=alpha, beta=beta, kappa=kappa,
+              affine_closed_form=closed_form)
     S, OUT = run_filter(obs, Y, U)
     posts, priors, logliks = kalman_filter(Y, U)
     np.testing.assert_allclose(OUT[:, :3], posts, rtol=0, atol=1e-10)

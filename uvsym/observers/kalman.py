@@ -127,8 +127,10 @@ def cholesky(A) -> tuple[ca.SX, ca.SX]:
             L[i][j] = ca.fmin(ca.fmax((A[i, j] - sum((L[i][k] * L[j][k] for k in range(j)), ca.SX(0.0))) / L[j][j],
                                       -BOUND), BOUND)
     margin = ca.fmax(margin, -1.0)
-    factor = ca.vertcat(*[ca.horzcat(*row) for row in L])
-    return ca.if_else(margin > 0.0, factor, ca.diag(ca.sqrt(ca.fabs(ca.diag(A)) + 1.0))), margin
+    healthy = margin > 0.0
+    factor = [[ca.if_else(healthy, L[i][j], ca.sqrt(ca.fabs(A[i, i]) + 1.0)) if i == j
+               else healthy * L[i][j] for j in range(n)] for i in range(n)]
+    return ca.vertcat(*[ca.horzcat(*row) for row in factor]), margin
 
 
 def _forward(L, B):

@@ -10,7 +10,9 @@ Cholesky factor of P, fault paper eq. 10: lower in an order with the passive sta
 (the paper prints ``w_i = lambda / (2 (n + lambda))``, whose weights do not sum to 1). Prediction
 (eqs. 12-14): ``xhat^- = sum w_m F(X_i)``, ``P^- = sum w_c (F(X_i) - xhat^-)(...)^T + Q``.
 Update (eqs. 15-20): sigma points redrawn from ``(xhat^-, P^-)`` (so Q enters P_zz and P_xz:
-the filter is exactly the Kalman filter on a linear Gaussian system), ``Z_i = h(X_i)``,
+the filter is exactly the Kalman filter on a linear Gaussian system), ``Z_i = h(X_i)``
+(for an output affine in x, ``h = H x + c``, the transform is exact and is evaluated in closed
+form: ``zhat = h(xhat^-)``, ``P_zz = H P^- H^T + R``, ``P_xz = P^- H^T``),
 ``P_zz = sum w_c dZ dZ^T + R``, ``P_xz = sum w_c dX dZ^T`` (eq. 18 with its missing transpose),
 ``K = P_xz P_zz^-1`` by Cholesky solves, ``xhat = xhat^- + K r``, ``P = P^- - K P_zz K^T =
 P^- - K P_xz^T`` (symmetrised, factorised with a relative jitter of 1e-12 at the next use).
@@ -84,12 +86,14 @@ def passive_last(system: System, F) -> list[int]:
 
 
 def unscented_filter(system: System, *, dt: float, Q, R, P0, x0=None, alpha: float = 1.0, beta: float = 2.0,
-                     kappa: float = 0.0, steps: int = 1, name: str = "ukf") -> GaussianFilter:
+                     kappa: float = 0.0, steps: int = 1, affine_closed_form: bool = True,
+                     name: str = "ukf") -> GaussianFilter:
     """The UKF of ``system`` (module docstring) as a :class:`~uvsym.observers.kalman.GaussianFilter`.
 
     dt: sample period (s); Q (n, n) process and R (n_y, n_y) measurement noise covariances per
     sample, P0 (n, n) and x0 (n,) the prior at the first sample (matrices, variance vectors or
-    scalars); steps: RK4 steps per sample of a continuous system. CovarianceError for Q, R or P0
+    scalars); steps: RK4 steps per sample of a continuous system; affine_closed_form: the update's
+    moments in closed form when h is affine in x (False: by sigma points all the same). CovarianceError for Q, R or P0
     not symmetric positive definite; ObserverError for alpha outside (0, 1] and other bad input.
     """
     Q, R, P0, x0 = checked_inputs(system, name, dt, Q, R, P0, x0)
@@ -113,13 +117,25 @@ def unscented_filter(system: System, *, dt: float, Q, R, P0, x0=None, alpha: flo
         deviations = [v - mean for v in FX]
         return mean, _spread(deviations, deviations, w_c, True) + ca.DM(Q), margin
 
-    def update(x, P, y, u, p):
+    xs, us, ps = ca.SX.sym("x", n), ca.SX.sym("u", system.u.size), ca.SX.sym("p", system.p.size)
+    H = ca.jacobian(system.h(xs, us, ps), xs)
+    output_matrix = None if ca.depends_on(H, xs) or not affine_closed_form else ca.Function("H", [us, ps], [H])
+
+    def moments(x, P, u, p):
+        """(z_mean, P_zz - R, P_xz, margin): by sigma points, or in closed form for h affine in x,
+        where the unscented transform is exact (``h(x), H P H^T, P H^T``; no factorisation)."""
+        if output_matrix is not None:
+            Hk = output_matrix(u, p)
+            return system.h(x, u, p), ca.mtimes(ca.mtimes(Hk, P), Hk.T), ca.mtimes(P, Hk.T), ca.SX(1.0)
         X, margin = sigma_points(x, P)
         Z = [system.h(Xi, u, p) for Xi in X]
         z_mean = _weighted(Z, w_m)
         dZ = [z - z_mean for z in Z]
-        P_zz = _spread(dZ, dZ, w_c, True) + ca.DM(R)
-        P_xz = _spread([Xi - x for Xi in X], dZ, w_c, False)
+        return z_mean, _spread(dZ, dZ, w_c, True), _spread([Xi - x for Xi in X], dZ, w_c, False), margin
+
+    def update(x, P, y, u, p):
+        z_mean, P_zz, P_xz, margin = moments(x, P, u, p)
+        P_zz = P_zz + ca.DM(R)
         L_S, margin_S = cholesky(P_zz)
         K = cho_solve(L_S, P_xz.T).T
         r = y - z_mean
@@ -127,7 +143,8 @@ def unscented_filter(system: System, *, dt: float, Q, R, P0, x0=None, alpha: flo
                 ca.fmin(margin, margin_S))
 
     return GaussianFilter(name, "ukf", system, float(dt), Q, R, P0, x0, update, predict,
-                          {"alpha": alpha, "beta": beta, "kappa": kappa, "steps": steps})
+                          {"alpha": alpha, "beta": beta, "kappa": kappa, "steps": steps,
+                           "affine_closed_form": output_matrix is not None})
 
 
 def ukf(system: System, **options) -> Observer:
