@@ -10,7 +10,10 @@ from uvsym.observers.actuator import (
     init_state,
     proportional_observer,
 )
+from uvsym.observers.ekf import ekf, extended_filter
+from uvsym.observers.mmae import mmae_bank
 from uvsym.observers.uio import UIOMatrices, uio_conditions, uio_matrices, uio_observer
+from uvsym.observers.ukf import ukf, unscented_filter
 
 __all__ = [
     "FORMS",
@@ -25,4 +28,9 @@ __all__ = [
     "uio_conditions",
     "uio_matrices",
     "uio_observer",
+    "ekf",
+    "extended_filter",
+    "mmae_bank",
+    "ukf",
+    "unscented_filter",
 ]
