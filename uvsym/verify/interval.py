@@ -31,167 +31,30 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import VerificationError
+from uvsym.verify.interval_arithmetic import (
+    LIBM_ULPS,
+    clean,
+    compare,
+    div,
+    even,
+    exact_zeros,
+    holds_zero,
+    increasing,
+    indicator,
+    mul,
+    periodic,
+    power,
+    round_down,
+    round_up,
+    signed_sum,
+    square,
+    truth,
+    twice,
+)
 
-__all__ = ["IntervalFunction", "Intervals", "round_down", "round_up"]
+__all__ = ["IntervalFunction", "Intervals"]
 
-LIBM_ULPS = 4
 _NAMES = {getattr(ca, name): name[3:].lower() for name in dir(ca) if name.startswith("OP_")}
-
-
-def round_down(x, ulps: int = 1):
-    for _ in range(ulps):
-        x = np.nextafter(x, -np.inf)
-    return x
-
-
-def round_up(x, ulps: int = 1):
-    for _ in range(ulps):
-        x = np.nextafter(x, np.inf)
-    return x
-
-
-def _clean(lo, hi):
-    """NaN bounds (0 * inf, inf - inf) become the widest bound."""
-    return np.where(np.isnan(lo), -np.inf, lo), np.where(np.isnan(hi), np.inf, hi)
-
-
-def _is_zero(a):
-    return (a[0] == 0) & (a[1] == 0)
-
-
-def _exact_zeros(result, a, b=None, value: float = 0.0):
-    """``result`` with the exact ``value`` where an operand is exactly 0 (no rounding to widen there)."""
-    zero = _is_zero(a) if b is None else _is_zero(a) | _is_zero(b)
-    return np.where(zero, value, result[0]), np.where(zero, value, result[1])
-
-
-def _twice(a):
-    """2 a: exact, except where it overflows (a bound of inf from a finite one moves inward)."""
-    with np.errstate(over="ignore"):
-        lo, hi = 2.0 * a[0], 2.0 * a[1]
-    return (np.where(np.isposinf(lo) & np.isfinite(a[0]), np.finfo(float).max, lo),
-            np.where(np.isneginf(hi) & np.isfinite(a[1]), -np.finfo(float).max, hi))
-
-
-def _rounded_sum(x, y, direction: float):
-    """x + y rounded towards ``direction`` (+-inf): left as it is where the float sum is exact.
-
-    Exactness by Knuth's TwoSum: the rounding error of ``s = x + y`` is
-    ``(x - (s - (s - x))) + (y - (s - x))``, exactly, barring overflow.
-    """
-    with np.errstate(all="ignore"):
-        total = x + y
-        y_part = total - x
-        error = (x - (total - y_part)) + (y - y_part)
-    exact = (error == 0) & np.isfinite(total)
-    return np.where(exact, total, np.nextafter(total, direction))
-
-
-def _sum(a, b, sign: float):
-    """a + sign b with bounds rounded outward only where the float sums are inexact."""
-    b_lo, b_hi = (b[0], b[1]) if sign > 0 else (-b[1], -b[0])
-    return _clean(_rounded_sum(a[0], b_lo, -np.inf), _rounded_sum(a[1], b_hi, np.inf))
-
-
-def _mul(a, b):
-    with np.errstate(invalid="ignore"):
-        products = np.stack([a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]])
-    products = np.where(np.isnan(products), 0.0, products)  # 0 * inf: a zero factor wins
-    return _exact_zeros((round_down(products.min(axis=0)), round_up(products.max(axis=0))), a, b)
-
-
-def _holds_zero(b):
-    return (b[0] <= 0.0) & (b[1] >= 0.0)
-
-
-def _div(a, b):
-    """a / b; where b holds 0 the box is undefined (the caller marks it) and the bounds unbounded."""
-    with np.errstate(all="ignore"):
-        quotients = np.stack([a[0] / b[0], a[0] / b[1], a[1] / b[0], a[1] / b[1]])
-    lo, hi = _exact_zeros(_clean(round_down(quotients.min(axis=0)), round_up(quotients.max(axis=0))), a)  # inf/inf: unbounded
-    straddles = _holds_zero(b)
-    return np.where(straddles, -np.inf, lo), np.where(straddles, np.inf, hi)
-
-
-def _even(a, function):
-    """An even function increasing on x >= 0 (x^2, cosh, x^4)."""
-    f_lo, f_hi = function(np.abs(a[0])), function(np.abs(a[1]))
-    lo = np.where(a[0] >= 0, f_lo, np.where(a[1] <= 0, f_hi, function(np.zeros_like(a[0]))))
-    return lo, np.maximum(f_lo, f_hi)
-
-
-def _increasing(function, ulps: int = LIBM_ULPS):
-    def apply(a):
-        with np.errstate(all="ignore"):
-            return _clean(round_down(function(a[0]), ulps), round_up(function(a[1]), ulps))
-    return apply
-
-
-def _periodic(a, function, peak: float, trough: float):
-    """sin or cos: endpoint values, and +-1 where the box holds a peak or a trough."""
-    with np.errstate(all="ignore"):
-        f0, f1 = function(a[0]), function(a[1])
-    lo, hi = round_down(np.minimum(f0, f1), LIBM_ULPS), round_up(np.maximum(f0, f1), LIBM_ULPS)
-    two_pi = 2.0 * np.pi
-    slack = 1e-9  # rounding of the peak positions: when in doubt the box holds one
-    holds_peak = np.floor((a[1] - peak) / two_pi + slack) >= np.ceil((a[0] - peak) / two_pi - slack)
-    holds_trough = np.floor((a[1] - trough) / two_pi + slack) >= np.ceil((a[0] - trough) / two_pi - slack)
-    # far from 0 the peak test loses precision: such boxes get the whole range
-    wide = ~(np.abs(a[0]) < 1e6) | ~(np.abs(a[1]) < 1e6) | (a[1] - a[0] >= two_pi)
-    hi = np.where(holds_peak | wide, 1.0, np.minimum(hi, 1.0))
-    lo = np.where(holds_trough | wide, -1.0, np.maximum(lo, -1.0))
-    return lo, hi
-
-
-def _truth(a):
-    """(certainly nonzero, certainly zero) per box."""
-    return (a[0] > 0) | (a[1] < 0), (a[0] == 0) & (a[1] == 0)
-
-
-def _indicator(true, false):
-    """Interval of a 0/1 value, and whether it is undecided (a kink inside the box)."""
-    undecided = ~true & ~false
-    return (np.where(true, 1.0, 0.0), np.where(false, 0.0, 1.0)), undecided
-
-
-def _compare(op, a, b):
-    if op == ca.OP_LT:
-        return _indicator(a[1] < b[0], a[0] >= b[1])
-    if op == ca.OP_LE:
-        return _indicator(a[1] <= b[0], a[0] > b[1])
-    point_equal = (a[0] == a[1]) & (b[0] == b[1]) & (a[0] == b[0])
-    disjoint = (a[1] < b[0]) | (b[1] < a[0])
-    if op == ca.OP_EQ:
-        return _indicator(point_equal, disjoint)
-    return _indicator(disjoint, point_equal)
-
-
-def _square(a):
-    lo, hi = _even(a, np.square)
-    return _exact_zeros(_clean(round_down(lo), round_up(hi)), a)
-
-
-def _power(a, exponent: float):
-    """a^exponent for a finite constant exponent: integers by repeated squaring (outward at each
-    step), others through the library pow (needs a >= 0, > 0 for a negative exponent)."""
-    ones = (np.ones_like(a[0]), np.ones_like(a[0]))
-    if exponent == np.floor(exponent):
-        n = abs(int(exponent))
-        result, base = ones, a
-        while n:
-            if n & 1:
-                result = _mul(result, base)
-            n >>= 1
-            if n:
-                base = _square(base)
-        return _div(ones, result) if exponent < 0 else result
-    if exponent > 0:
-        lo, hi = np.maximum(a[0], 0.0) ** exponent, np.maximum(a[1], 0.0) ** exponent
-    else:
-        with np.errstate(divide="ignore"):
-            lo, hi = np.maximum(a[1], 0.0) ** exponent, np.maximum(a[0], 0.0) ** exponent
-    return _clean(round_down(lo, LIBM_ULPS), round_up(hi, LIBM_ULPS))
-
 
 def _outside_domain(op: int, args) -> np.ndarray | None:
     """(k,) True where the operation's argument may leave its domain; None for total operations."""
@@ -203,13 +66,13 @@ def _outside_domain(op: int, args) -> np.ndarray | None:
     if op == ca.OP_LOG1P:
         return a[0] <= -1
     if op == ca.OP_DIV:
-        return _holds_zero(args[1])
+        return holds_zero(args[1])
     if op == ca.OP_INV:
-        return _holds_zero(a)
+        return holds_zero(a)
     if op in (ca.OP_CONSTPOW, ca.OP_POW):
         exponent = float(args[1][0][0]) if len(args[1][0]) else 0.0
         if exponent == np.floor(exponent):
-            return _holds_zero(a) if exponent < 0 else None
+            return holds_zero(a) if exponent < 0 else None
         return a[0] <= 0 if exponent < 0 else a[0] < 0
     return None
 
@@ -283,7 +146,7 @@ class IntervalFunction:
             elif op == ca.OP_CONST:
                 if not np.isfinite(constant):
                     defined[:] = False
-                work[outputs[0]] = _clean(np.full(k, constant), np.full(k, constant))
+                work[outputs[0]] = clean(np.full(k, constant), np.full(k, constant))
             else:
                 args = [work[i] for i in inputs]
                 with np.errstate(all="ignore"):
@@ -291,14 +154,14 @@ class IntervalFunction:
                 if kink is not None:
                     smooth &= ~kink
                 if op in _ZERO_AT_ZERO:
-                    result = _exact_zeros(result, args[0])
+                    result = exact_zeros(result, args[0])
                 elif op in _ONE_AT_ZERO:
-                    result = _exact_zeros(result, args[0], value=1.0)
+                    result = exact_zeros(result, args[0], value=1.0)
                 outside = _outside_domain(op, args)
                 if outside is not None:
                     defined &= ~outside
                     result = (np.where(outside, -np.inf, result[0]), np.where(outside, np.inf, result[1]))
-                work[outputs[0]] = _clean(*result)
+                work[outputs[0]] = clean(*result)
         return Intervals(out_lo, out_hi, smooth, defined)
 
     def _apply(self, op: int, args):
@@ -308,37 +171,37 @@ class IntervalFunction:
         if op == ca.OP_ASSIGN:
             return a, None
         if op == ca.OP_ADD:
-            return _sum(a, b, 1.0), None
+            return signed_sum(a, b, 1.0), None
         if op == ca.OP_SUB:
-            return _sum(a, b, -1.0), None
+            return signed_sum(a, b, -1.0), None
         if op == ca.OP_MUL:
-            return _mul(a, b), None
+            return mul(a, b), None
         if op == ca.OP_DIV:
-            return _div(a, b), None
+            return div(a, b), None
         if op == ca.OP_INV:
-            return _div((np.ones_like(a[0]), np.ones_like(a[0])), a), None
+            return div((np.ones_like(a[0]), np.ones_like(a[0])), a), None
         if op == ca.OP_NEG:
             return (-a[1], -a[0]), None
         if op == ca.OP_TWICE:
-            return _twice(a), None
+            return twice(a), None
         if op == ca.OP_SQ:
-            return _square(a), None
+            return square(a), None
         if op == ca.OP_COSH:
-            lo, hi = _even(a, np.cosh)
-            return _clean(round_down(lo, LIBM_ULPS), round_up(hi, LIBM_ULPS)), None
+            lo, hi = even(a, np.cosh)
+            return clean(round_down(lo, LIBM_ULPS), round_up(hi, LIBM_ULPS)), None
         if op in _MONOTONE:
-            return _increasing(_MONOTONE[op])(a), None
+            return increasing(_MONOTONE[op])(a), None
         if op in _POSITIVE_DOMAIN:  # boxes reaching outside the domain are marked undefined by the caller
             clipped = (np.maximum(a[0], 0.0), np.maximum(a[1], 0.0))
-            return _increasing(_POSITIVE_DOMAIN[op], 1 if op == ca.OP_SQRT else LIBM_ULPS)(clipped), None
+            return increasing(_POSITIVE_DOMAIN[op], 1 if op == ca.OP_SQRT else LIBM_ULPS)(clipped), None
         if op == ca.OP_SIN:
-            return _periodic(a, np.sin, np.pi / 2, -np.pi / 2), None
+            return periodic(a, np.sin, np.pi / 2, -np.pi / 2), None
         if op == ca.OP_COS:
-            return _periodic(a, np.cos, 0.0, np.pi), None
+            return periodic(a, np.cos, 0.0, np.pi), None
         if op in (ca.OP_CONSTPOW, ca.OP_POW):
             if not np.all(b[0] == b[1]) or not np.all(b[0] == b[0][0]) or not np.all(np.isfinite(b[0])):
                 raise VerificationError("interval power needs a constant, finite exponent")
-            return _power(a, float(b[0][0])), None
+            return power(a, float(b[0][0])), None
         if op == ca.OP_FABS:
             kink = (a[0] < 0) & (a[1] > 0)
             return (np.where(a[0] >= 0, a[0], np.where(a[1] <= 0, -a[1], 0.0)),
@@ -353,15 +216,15 @@ class IntervalFunction:
             pick = np.minimum if op == ca.OP_FMIN else np.maximum
             return (pick(a[0], b[0]), pick(a[1], b[1])), np.maximum(a[0], b[0]) <= np.minimum(a[1], b[1])
         if op in (ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE):
-            return _compare(op, a, b)
-        true, false = _truth(a)
+            return compare(op, a, b)
+        true, false = truth(a)
         if op == ca.OP_NOT:
-            return _indicator(false, true)
+            return indicator(false, true)
         if op in (ca.OP_AND, ca.OP_OR):
-            b_true, b_false = _truth(b)
+            b_true, b_false = truth(b)
             if op == ca.OP_AND:
-                return _indicator(true & b_true, false | b_false)
-            return _indicator(true | b_true, false & b_false)
+                return indicator(true & b_true, false | b_false)
+            return indicator(true | b_true, false & b_false)
         # OP_IF_ELSE_ZERO(condition, value)
         lo = np.where(true, b[0], np.where(false, 0.0, np.minimum(b[0], 0.0)))
         hi = np.where(true, b[1], np.where(false, 0.0, np.maximum(b[1], 0.0)))

@@ -6,7 +6,8 @@ LMI solved with cvxpy and Clarabel, then re-checks the answer without the solver
 rationals and ``P`` and ``-(A_i^T P + P A_i + 2 gamma P)`` are shown positive definite by exact
 rational LDL^T factorisation (every pivot > 0). The margin is the smallest pivot ratio found.
 
-Only when that fails is the claim decided otherwise. Refutation is exact: a common P needs every vertex to have all eigenvalues left of ``-gamma``,
+Only when that fails is the claim decided otherwise. Refutation is exact: a common P needs every
+vertex to have all eigenvalues left of ``-gamma``,
 which :func:`uvsym.verify.exact.shifted_hurwitz` decides by Routh-Hurwitz on the characteristic
 polynomial in rationals (never by a floating-point eigenvalue, which is wrong for non-normal and
 defective matrices). For a single vertex that test is also a proof (Lyapunov's theorem gives P)

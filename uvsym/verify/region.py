@@ -34,7 +34,8 @@ import numpy as np
 from uvsym.errors import VerificationError
 from uvsym.progress import ProgressBar
 from uvsym.verify.certificate import Certificate
-from uvsym.verify.interval import IntervalFunction, Intervals, round_up
+from uvsym.verify.interval import IntervalFunction, Intervals
+from uvsym.verify.interval_arithmetic import round_up
 from uvsym.verify.lyapunov import exact_positive_definite
 
 __all__ = ["region_decrease"]
