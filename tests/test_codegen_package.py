@@ -116,12 +116,13 @@ def test_two_observer_packages_link_into_one_program_and_export_only_prefixed_na
     other = observer_set("actuator-observers", vehicle="otter3dof", form="momentum")
     other.write(tmp_path / "otter")
     packages = {made.package_name: out, other.package_name: tmp_path / "otter"}
+    objects = []
     for name, folder in packages.items():  # every defined external symbol carries the package's name
-        obj = tmp_path / f"{name}.o"
         for source in ("_casadi", ""):
-            subprocess.run([find_compiler(), "-std=c99", "-c", "-I", str(folder / "include"),
-                            str(folder / "src" / f"{name}{source}.c"), "-o", str(obj)], check=True)
-            symbols = subprocess.run(["nm", "-g", "--defined-only", str(obj)], capture_output=True, text=True,
+            objects.append(tmp_path / f"{name}{source}.o")
+            subprocess.run([find_compiler(), *STRICT, "-c", "-I", str(folder / "include"),
+                            str(folder / "src" / f"{name}{source}.c"), "-o", str(objects[-1])], check=True)
+            symbols = subprocess.run(["nm", "-g", "--defined-only", str(objects[-1])], capture_output=True, text=True,
                                      check=True).stdout.split()[2::3]
             assert symbols and all(s.startswith(name) for s in symbols), [s for s in symbols if not s.startswith(name)]
     (tmp_path / "both.c").write_text(f"""#include <stdio.h>
@@ -141,10 +142,8 @@ int main(void) {{
   return 0;
 }}
 """)
-    sources = [str(folder / "src" / f"{name}{suffix}.c") for name, folder in packages.items()
-               for suffix in ("_casadi", "")]
     includes = [flag for folder in packages.values() for flag in ("-I", str(folder / "include"))]
-    done = subprocess.run([find_compiler(), *STRICT, *includes, str(tmp_path / "both.c"), *sources,
+    done = subprocess.run([find_compiler(), *STRICT, *includes, str(tmp_path / "both.c"), *map(str, objects),
                            "-o", str(tmp_path / "both"), "-lm"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     values = [float(v) for v in subprocess.run([str(tmp_path / "both")], capture_output=True, text=True,
