@@ -63,24 +63,39 @@ class Design:
     blocks: tuple
 
 
+def _yaw_model(plant: System) -> tuple[float, float]:
+    """(T, K) of the linearised yaw model ``psi / u = K / (s (T s + 1))``: T in s, K in rad/s per unit u."""
+    lin = plant.linearize()
+    T = -1.0 / lin.A[1, 1]  # m66 / |N_r|
+    return T, lin.B[1, 0] * T
+
+
 def heading_gain(plant: System, bandwidth: float = BANDWIDTH) -> float:
     """kp (per rad) of ``u = kp (psi_ref - psi)``: the linearised loop's natural frequency is ``bandwidth`` (rad/s)."""
-    lin = plant.linearize()
-    T = -1.0 / lin.A[1, 1]  # s, yaw time constant m66 / |N_r|
-    K = lin.B[1, 0] * T  # rad/s per unit u
+    T, K = _yaw_model(plant)
     return T * bandwidth ** 2 / K
 
 
+def pi_gains(plant: System) -> tuple[float, float]:
+    """(kp per rad, ki per rad s) of a PI heading law placing the linearised loop's three poles at
+    ``-1 / (3 T)`` (``T s^3 + s^2 + K kp s + K ki``, the fastest triple pole without derivative)."""
+    T, K = _yaw_model(plant)
+    a = 1.0 / (3.0 * T)
+    return 3.0 * a ** 2 * T / K, a ** 3 * T / K
+
+
 def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0: float = R0, window: int = WINDOW,
-           hold: int = HOLD, confirm: int = CONFIRM, set_point_deg: float = SET_POINT_DEG) -> Design:
-    """The plant, the monitor and the heading loop's blocks (ObserverError for bad monitor settings)."""
+           hold: int = HOLD, confirm: int = CONFIRM, set_point_deg: float = SET_POINT_DEG,
+           bandwidth: float = BANDWIDTH, integral: bool = False) -> Design:
+    """The plant, the monitor and the heading loop's blocks (ObserverError for bad monitor settings);
+    ``integral``: the PI law of :func:`pi_gains` instead of the proportional one."""
     plant = uvsym.plant("rov_yaw")
     monitor = lms_monitor(plant.y, plant.u, reference=signals(("psi_ref", "rad", "heading set-point")),
                           order=order, mu=mu, eps0=_positive_deg2(eps0_deg2), r0=r0, dt=DT, window=window,
                           hold=hold, confirm=confirm, name="lms")
-    kp = heading_gain(plant)
+    kp, ki = pi_gains(plant) if integral else (heading_gain(plant, bandwidth), 0.0)
     reference = open_loop("reference", [0.0], [math.radians(set_point_deg)], publishes=["psi_ref"])
-    controller = pid("heading", "psi", "psi_ref", output="u", kp=kp, limits=(-1.0, 1.0), dt=DT)
+    controller = pid("heading", "psi", "psi_ref", output="u", kp=kp, ki=ki, limits=(-1.0, 1.0), dt=DT)
     return Design(plant, monitor, kp, (reference, controller, observer_block(monitor)))
 
 

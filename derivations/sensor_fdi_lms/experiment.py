@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from derivations.sensor_fdi_lms.design import (
+    BANDWIDTH,
     COMPASS_NOISE_DEG,
     DT,
     EPS0_DEG2,
@@ -43,7 +44,8 @@ class Run:
     kind drift), ``profile`` (step, pulse: ``length`` samples, ramp over ``length`` samples,
     incipient with time constant ``length`` samples, intermittent of period ``2 length``) from
     recorded sample ``onset``; None size: no fault. ftc: substitute the sensor once the fault is
-    confirmed (``substitute_on="fault"``) or from the first eps^2 alarm (``"alarm"``, Sec. 4.3)."""
+    confirmed (``substitute_on="fault"``) or from the first eps^2 alarm (``"alarm"``, Sec. 4.3).
+    bandwidth (rad/s): of the proportional heading law; integral: the PI law instead."""
 
     size_deg: float | None = 30.0
     onset: int = FAULT_SAMPLE
@@ -60,6 +62,8 @@ class Run:
     mu: float = MU
     eps0_deg2: float = EPS0_DEG2
     r0: float = R0
+    bandwidth: float = BANDWIDTH
+    integral: bool = False
 
     def profile_object(self) -> Profile:
         """The fault's time profile in s of loop time."""
@@ -95,8 +99,10 @@ class Outcome:
 
 
 def run(spec: Run) -> Outcome:
-    """Simulate ``spec`` (compiled fixed-step RK4, 4 steps per sample)."""
-    d = design(order=spec.order, mu=spec.mu, eps0_deg2=spec.eps0_deg2, r0=spec.r0)
+    """Simulate ``spec`` (fixed-step RK4, 4 steps per sample, on CasADi's virtual machine: with the
+    supervisor deciding every sample, building C would cost more than it saves)."""
+    d = design(order=spec.order, mu=spec.mu, eps0_deg2=spec.eps0_deg2, r0=spec.r0, bandwidth=spec.bandwidth,
+               integral=spec.integral)
     plant = d.plant
     samples = spec.warm_up + spec.record
     faults = [SensorFault(plant.y.index("psi"), "noise", math.radians(COMPASS_NOISE_DEG))]
@@ -106,7 +112,7 @@ def run(spec: Run) -> Outcome:
     supervisor = SubstitutionSupervisor(d.monitor, correct=spec.ftc, substitute_on=spec.substitute_on)
     result = simulate_system(plant, d.blocks, duration=samples * DT, dt=DT, x0=[math.radians(SET_POINT_DEG), 0.0],
                              sensor_faults=tuple(faults), substitutions={"psi": "psi_sub"}, supervisor=supervisor,
-                             d=torque_table(samples, spec.seed), seed=spec.seed, substeps=4)
+                             d=torque_table(samples, spec.seed), seed=spec.seed, substeps=4, compiled=False)
     return Outcome(spec, result, supervisor)
 
 

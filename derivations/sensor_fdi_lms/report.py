@@ -26,6 +26,8 @@ PAPER = {"eps2_first_alarm_sample": 70, "R_first_alarm_sample": 75,
          "spike_classified_as": "disturbance"}
 SETTLED = 100  # samples (20 s) at the end of the record whose mean heading is the settled heading
 FTC_WINDOW = 300  # samples (60 s) after the onset over which the FTC error is taken
+FTC_SEEDS = tuple(range(8))  # noise seeds of the FTC robustness runs
+BANDWIDTHS = (0.35, D.BANDWIDTH, 1.4)  # rad/s, the proportional law's natural frequencies compared
 
 
 def _summary(outcome) -> dict:
@@ -61,6 +63,25 @@ def _runs(progress) -> tuple[dict, dict]:
     return outcomes, summaries
 
 
+def _max_error(spec: Run) -> float:
+    return _summary(run(spec))["max_abs_heading_error_deg"]
+
+
+def _robustness(progress) -> dict:
+    """The FTC error over noise seeds (both substitution rules) and over heading laws (+30 deg, seed 0)."""
+    seeds = {}
+    for size in D.FAULT_SIZES_DEG:
+        progress(f"FTC over {len(FTC_SEEDS)} noise seeds: +{size:g} deg")
+        for mode in ("fault", "alarm"):
+            errors = [_max_error(Run(size_deg=size, substitute_on=mode, seed=seed)) for seed in FTC_SEEDS]
+            seeds.setdefault(f"{size:g}", {})[mode] = {"max_abs_error_deg": errors,
+                                                        "within_3_deg": sum(e <= 3.0 for e in errors)}
+    progress("FTC under other heading laws")
+    laws = {f"P, {b:g} rad/s": _max_error(Run(size_deg=30.0, bandwidth=b)) for b in BANDWIDTHS}
+    laws["PI, triple pole at -1/(3T)"] = _max_error(Run(size_deg=30.0, integral=True))
+    return {"seeds": list(FTC_SEEDS), "over_seeds": seeds, "heading_laws": laws}
+
+
 def _learning(u: np.ndarray, outcome) -> dict:
     """How much the filter learns: input power, mu M P_u, adaptation time, weights and prediction."""
     k = outcome.k
@@ -77,6 +98,7 @@ def _learning(u: np.ndarray, outcome) -> dict:
 def build(out_dir: Path, progress) -> None:
     """Run the reproduction and the detection study, export C, check the claims, write the report."""
     outcomes, summaries = _runs(progress)
+    robustness = _robustness(progress)
     progress(f"detection study: {2 * 100} runs over noise seeds, ROC over thresholds")
     study = detection_study()
     progress("C package of the monitor: write, compile, compare")
@@ -103,7 +125,7 @@ def build(out_dir: Path, progress) -> None:
             "max_abs_heading_error_deg"] for size in ftc},
         "spike_classified_as": _classified(summaries["spike"]),
         "spike_substituted": summaries["spike"]["substituted_from_sample"] is not None,
-        "runs": summaries, "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
+        "runs": summaries, "robustness": robustness, "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
         "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
                   "nominal": study.delays, "r0_grid": list(R0_GRID)},
         "paper": PAPER, "c": c, "claims": claims, "negative_factor": NEGATIVE_FACTOR,

@@ -61,6 +61,29 @@ def _nominal(r: dict) -> str:
                           rows)
 
 
+def _robustness(r: dict) -> str:
+    rob = r["robustness"]
+    rows = []
+    for size, modes in rob["over_seeds"].items():
+        for mode, name in (("fault", "once confirmed"), ("alarm", "from the eps^2 alarm")):
+            errors = sorted(modes[mode]["max_abs_error_deg"])
+            rows.append([f"+{size} deg", name, f"{errors[0]:.2f}", f"{errors[len(errors) // 2]:.2f}",
+                         f"{errors[-1]:.2f}", f"{modes[mode]['within_3_deg']} of {len(errors)}"])
+    seeds = markdown_table(["fault", "substitution", "min", "median", "max", "runs within 3 deg"], rows)
+    laws = markdown_table(["heading law", "max abs error (deg), +30 deg, substitution once confirmed"],
+                          [[law, f"{value:.2f}"] for law, value in rob["heading_laws"].items()])
+    return f"""Largest heading error in the 60 s after the fault over noise seeds {rob['seeds'][0]}-{rob['seeds'][-1]}
+(compass noise and yaw torque), in deg:
+
+{seeds}
+
+And under other heading laws (seed 0): the error grows with the law's gain, which acts on the
+faulty reading until the substitution; an integral term, wound up on those samples, keeps
+turning the vehicle once the sensor is replaced by a prediction that does not see the heading:
+
+{laws}"""
+
+
 def report_text(r: dict, source) -> str:
     """The report (Markdown) from the results ``r`` and the paper ``source`` (derivations.papers.Paper)."""
     c, learning, study = r["choices"], r["learning"], r["study"]
@@ -141,6 +164,10 @@ frozen filter's substitute is then the set-point itself: the FTC holds the comma
 gives a zero error, and the heading error after the switch is the transient before it plus the
 drift the yaw torque causes while the heading is not measured. The $\\varepsilon^2$ and $R$ criteria do
 not need a trained filter (a step in the measurement is a step in $e$).
+
+### Fault-tolerant control: noise seeds and heading laws
+
+{_robustness(r)}
 
 ![criteria](fig3_criteria.svg)
 
