@@ -68,14 +68,23 @@ def _robustness(r: dict) -> str:
         for mode, name in (("fault", "once confirmed"), ("alarm", "from the eps^2 alarm")):
             errors = sorted(modes[mode]["max_abs_error_deg"])
             rows.append([f"+{size} deg", name, f"{errors[0]:.2f}", f"{errors[len(errors) // 2]:.2f}",
-                         f"{errors[-1]:.2f}", f"{modes[mode]['within_3_deg']} of {len(errors)}"])
-    seeds = markdown_table(["fault", "substitution", "min", "median", "max", "runs within 3 deg"], rows)
+                         f"{errors[-1]:.2f}", f"{modes[mode]['within_3_deg']} of {len(errors)}",
+                         f"{modes[mode]['confirmed']} of {len(errors)}"])
+    seeds = markdown_table(["fault", "substitution", "min", "median", "max", "runs within 3 deg",
+                            "runs where R confirmed"], rows)
     laws = markdown_table(["heading law", "max abs error (deg), +30 deg, substitution once confirmed"],
                           [[law, f"{value:.2f}"] for law, value in rob["heading_laws"].items()])
     return f"""Largest heading error in the 60 s after the fault over noise seeds {rob['seeds'][0]}-{rob['seeds'][-1]}
 (compass noise and yaw torque), in deg:
 
 {seeds}
+
+Substituting from the $\\varepsilon^2$ alarm removes the transient, but it also stops the loop from
+reacting to the faulty reading: the command, and with it the weight drift that $R$ measures, stays
+small, so $R$ may not confirm. The freeze is then released, the faulty sensor switched back in,
+frozen again at the next alarm, and so on (the runs where $R$ did not confirm above); substituting
+once confirmed lets the loop act on the fault for {r['runs']['30']['ftc']['substituted_from_sample'] - 70} samples,
+which is what makes the weights drift.
 
 And under other heading laws (seed 0): the error grows with the law's gain, which acts on the
 faulty reading until the substitution; an integral term, wound up on those samples, keeps
@@ -108,7 +117,11 @@ The FTC rows use the rule of the issue this study answers: substitute once the d
 confirms the fault (so that a disturbance never switches the sensor). The paper's own experiment
 (Sec. 4.3, L625-630) substitutes from the first $\\varepsilon^2$ alarm; with that rule the largest
 errors are {", ".join(f"+{s} deg: {v:.2f} deg" for s, v in r["max_abs_heading_error_with_ftc_on_alarm_deg"].items())},
-but a one-sample disturbance then switches the sensor out for {D.CONFIRM} samples.
+but a one-sample disturbance then switches the sensor out for {D.CONFIRM} samples. The FTC rows miss
+because the heading law acts on the faulty reading for the samples between the fault and the
+switch (R confirms {r['R_first_alarm_sample'] - 70} samples after the fault, the supervisor switches on the next):
+on this fast-turning proxy (37 deg/s at full thrust) that transient alone is a few degrees. How
+it depends on the noise seed, the substitution rule and the heading law is measured below.
 
 Every run (recorded samples from the start of the record, the fault at {D.FAULT_SAMPLE}):
 
@@ -160,8 +173,8 @@ record is $P_u$ = {learning['input_power']:.3g}, so $\\mu M P_u$ = {learning['mu
 time $1 / (2 \\mu P_u)$ is {learning['adaptation_samples']:.3g} samples. With the paper's $\\mu$ the filter stays
 at its initial weights: its prediction error before the fault, {learning['rms_prediction_error_deg']:.3g} deg RMS,
 equals the measured deviation from the set-point, {learning['rms_measured_deviation_deg']:.3g} deg RMS. The
-frozen filter's substitute is then the set-point itself: the FTC holds the command the controller
-gives a zero error, and the heading error after the switch is the transient before it plus the
+frozen filter's substitute is then the set-point itself: after the switch the controller sees no
+error and commands nothing, and the heading error is the transient before the switch plus the
 drift the yaw torque causes while the heading is not measured. The $\\varepsilon^2$ and $R$ criteria do
 not need a trained filter (a step in the measurement is a step in $e$).
 
@@ -199,12 +212,13 @@ At the nominal thresholds:
 The step-size claim takes $P_u$ as the mean square of the healthy run's recorded command and decides
 $\\mu M P_u < 1$ in exact rational arithmetic on the samples' binary values (the mean-square bound of
 independence theory, Widrow & Stearns 1985, $\\operatorname{{tr}} R_{{UU}} = M P_u$). The negative control
-$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted ({negative['claim']}): exact
-$\\mu M P_u$ = {r['negative_factor']:g}.
+$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted as it must be: exact $\\mu M P_u$ = {r['negative_factor']:g}
+({negative['claim']}).
 `uvsym simulate` warns (`StepSizeWarning`, with the bound) when a scenario's $\\mu$ is at or beyond the
 bound of its own run.
 
 ## Generated C
 
-{c_section(r["c"], "The monitor's step (the LMS update, both criteria, the freeze and the double criterion)")}
+{c_section(r["c"], "The monitor's step (the LMS update, both criteria, the freeze and the double criterion) "
+                   "and the bare LMS step it is built on")}
 """
