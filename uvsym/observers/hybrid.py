@@ -149,8 +149,11 @@ class FaultEstimator:
 
 
 def _gain(value, shape: tuple[int, int], what: str, name: str) -> np.ndarray:
-    M = np.asarray(value, dtype=float).reshape(shape) if np.size(value) == shape[0] * shape[1] else None
-    if M is None or not np.all(np.isfinite(M)):
+    try:
+        M = np.atleast_2d(np.asarray(value, dtype=float))
+    except (TypeError, ValueError):
+        M = None
+    if M is None or M.shape != shape or not np.all(np.isfinite(M)):
         raise ObserverError(f"{name}: {what} must be a finite {shape} matrix, got shape {np.shape(value)}")
     return M
 
