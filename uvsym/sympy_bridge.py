@@ -9,6 +9,7 @@ result evaluates to the same numbers as the CasADi expression.
 
 from __future__ import annotations
 
+import math
 import re
 
 import casadi as ca
@@ -51,14 +52,19 @@ def _indicator(condition):
     return sp.Piecewise((1, condition), (0, True))
 
 
-def _constant(value: float):
+def _constant(value: float, exact: bool = False):
+    if exact and math.isfinite(value):
+        return sp.Rational(value)  # the double's exact binary value
     if value == int(value) and abs(value) < 2**53:
         return sp.Integer(int(value))
     return sp.Float(repr(value), 17)
 
 
-def to_sympy(expression) -> sp.Matrix | sp.Expr:
+def to_sympy(expression, exact: bool = False) -> sp.Matrix | sp.Expr:
     """The sympy form of an SX scalar or matrix (a Matrix of the same shape for a matrix).
+
+    ``exact=True`` gives every constant as the rational it stores, so that sympy's arithmetic on
+    them is exact (Floats would be combined at 17 digits).
 
     Raises UvsymError for an MX expression or an operation without a sympy equivalent.
     """
@@ -74,7 +80,7 @@ def to_sympy(expression) -> sp.Matrix | sp.Expr:
         if node.is_symbolic():
             result = sp.Symbol(node.name(), real=True)
         elif node.is_constant():
-            result = _constant(float(node))
+            result = _constant(float(node), exact)
         else:
             op = node.op()
             if node.n_dep() == 1 and op in _UNARY:

@@ -48,11 +48,6 @@ WALL_FACTOR = 20  # wall-clock allowance of a loaded machine, per CPU second
 SIMPLIFY_OPS = 200  # entries larger than this are not handed to sympy.simplify
 
 
-def _exact(expression: sp.Expr) -> sp.Expr:
-    """``expression`` with every Float replaced by the rational it stores, exactly."""
-    return expression.xreplace({f: sp.Rational(float(f)) for f in expression.atoms(sp.Float)})
-
-
 def _atomised(expression: sp.Expr) -> sp.Expr:
     """Non-rational sub-expressions (functions, non-integer powers) replaced by fresh symbols, so
     that what is left is a rational function (its arguments normalised first)."""
@@ -115,9 +110,9 @@ def _symbolic(entries: list[sp.Expr], seconds: float) -> str:
 
 
 def _entries(expression: ca.SX) -> list[sp.Expr]:
-    """The entries of vec(expression) in sympy, constants as exact rationals."""
-    converted = to_sympy(ca.densify(ca.vec(expression)))
-    return [_exact(e) for e in (list(converted) if isinstance(converted, sp.MatrixBase) else [converted])]
+    """The entries of vec(expression) in sympy, constants as the exact rationals they store."""
+    converted = to_sympy(ca.densify(ca.vec(expression)), exact=True)
+    return list(converted) if isinstance(converted, sp.MatrixBase) else [converted]
 
 
 def _magnitude(expression: sp.Expr) -> sp.Expr:
