@@ -56,6 +56,7 @@ def test_decoupling_removes_the_disturbance_direction():
     assert np.allclose(dec.Tu @ dec.E1, 0) and np.allclose(dec.H, [[1.0], [1.0]])  # by hand: H = E1 / (C1 E1)
     assert np.allclose(dec.omega["Omega1"], [[0.0, 0.0], [2.0, -3.0]])  # (I - H C1) A11
     assert dec.ranks == {"B": 1, "E": 1, "C[B E]": 1, "m + r": 2}  # C B = 0: Assumption 1 fails here too
+    assert dec.undetectable == ()  # (C1, Tu A11) = ([1, 0], [[0, 0], [2, -3]]): the mode -3 is stable
 
 
 def test_unknown_input_observer_estimates_through_a_large_disturbance():
@@ -119,7 +120,7 @@ def test_bad_decouplings_and_gains_are_typed_errors():
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y1"], F=[[1.0], [0.0]])
     with pytest.raises(ObserverError, match="disturbance E must act on subsystem 1"):
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y1"], E=[[0.0], [0.0], [1.0]])
-    with pytest.raises(ObserverError, match="rank\\(C1 E1\\)"):
+    with pytest.raises(ObserverError, match="rank\\(C D\\) = 0 but rank\\(D\\) = 1"):
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y1"], E=[[0.0], [1.0], [0.0]])
     with pytest.raises(ObserverError, match="w1 read subsystem-2 states"):
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y3"])

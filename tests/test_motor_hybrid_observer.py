@@ -33,6 +33,7 @@ def test_flux_modes_are_invisible_to_the_currents_whatever_K1():
         assert np.min(np.abs(eigenvalues - 1j * omega_s)) < 1e-6 and np.abs(eigenvalues.real).min() < 1e-9
     pbh = np.vstack([Om - 1j * omega_s * np.eye(4), C1])
     assert np.linalg.matrix_rank(pbh, tol=1e-8) == 3
+    assert sorted(np.round(np.imag(d.split.undetectable), 6)) == [-omega_s, omega_s]  # the UIO conditions agree
 
 
 def test_estimator_steady_state_matches_the_hand_derivation():

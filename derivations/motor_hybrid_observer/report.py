@@ -136,6 +136,7 @@ def _results(cases: dict) -> dict:
         "Tu_E1_relative": float(np.max(np.abs(split.Tu @ split.E1)) / np.max(np.abs(split.E1))),
         "Tu_A12_relative": float(np.max(np.abs(split.omega["Omega2"])) / np.max(np.abs(d.lin.A[list(split.iz1), 4]))),
         "Omega1_eigenvalues": _pairs(np.linalg.eigvals(split.omega["Omega1"])),
+        "subsystem1_undetectable": _pairs(split.undetectable),
         "estimator_error_eigenvalues": _pairs(np.linalg.eigvals(estimator_model().A)),
         "corrected_error_eigenvalues": _pairs(np.linalg.eigvals(corrected_model().A)),
         "corrected_gain": d.corrected.K[0].tolist(),

@@ -114,7 +114,8 @@ In words:
    relative. But Tu = I - H C1 removes every rotor-resistance term, and with them the rotor flux's
    damping alpha = Rr/Lr: the flux rows of Tu A11 are the stator "voltage model", a pure rotation,
    so Omega1 = Tu A11 has the eigenvalues {_eigs(r["Omega1_eigenvalues"])} and the two at
-   +-omega_s are not seen by the currents. No K1 moves them, so **LMI (11) of Theorem 1 has no
+   +-omega_s are not seen by the currents (`uvsym.observers.uio.uio_conditions`: (C1, Tu A11) is
+   not detectable, modes {_eigs(r["subsystem1_undetectable"])}). No K1 moves them, so **LMI (11) of Theorem 1 has no
    solution**: the dual certificate above (Z on the two flux errors) excludes every P1, P2, Y1, Y2.
 3. **Theorem 2 fails twice.** Besides the flux modes, the speed-and-fault block has a mode at 0
    that its only measurement, omega_m + 2 f_s, does not see (the direction e_f = -e_2 / 2): a speed

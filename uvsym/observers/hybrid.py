@@ -32,8 +32,9 @@ import casadi as ca
 import numpy as np
 import sympy
 
-from uvsym.errors import ObserverError
+from uvsym.errors import ObserverError, UIOConditionError
 from uvsym.observers.base import Observer, check_name, observer
+from uvsym.observers.uio import uio_conditions
 from uvsym.symbolic import rk4
 from uvsym.systems.signals import Signals, signals
 from uvsym.systems.system import Linearization, System, system
@@ -62,7 +63,8 @@ class Decoupling:
     """The split of the module docstring. z1, z2, w1, w2: state and output names; C1 (p1, n1),
     C4 (p2, n2), F2 (p2, q), E1 (n1, r), H (n1, p1), Tu (n1, n1); omega: Omega1..4 (floats);
     exact: the same as sympy Rational matrices (Tu, H, Omega_i computed in exact arithmetic from
-    the linearisation's doubles); ranks: rank B, rank E, rank C [B E], m + r (Assumption 1)."""
+    the linearisation's doubles); ranks: rank B, rank E, rank C [B E], m + r (Assumption 1);
+    undetectable: eigenvalues of Tu A11 with Re >= 0 that C1 does not see (no K1 moves them)."""
 
     plant: str
     z1: tuple[str, ...]
@@ -82,6 +84,7 @@ class Decoupling:
     omega: dict
     exact: dict
     ranks: dict
+    undetectable: tuple[complex, ...] = ()
 
 
 def _names(group: Signals, names, what: str) -> tuple[int, ...]:
@@ -100,7 +103,9 @@ def decouple(plant: System, lin: Linearization, *, z1, w1, E=None, F=None) -> De
     ------
     ObserverError
         Unknown names; outputs of one subsystem that read the other's states; a disturbance acting on
-        subsystem 2 or a fault on subsystem 1's outputs; ``rank(C1 E1) != rank(E1)`` (no UIO exists).
+        subsystem 2 or a fault on subsystem 1's outputs; ``rank(C1 E1) != rank(E1)`` (no UIO exists;
+        checked by :func:`uvsym.observers.uio.uio_conditions`, whose detectability verdict is kept
+        in ``undetectable`` rather than raised, for the LMI claims to refute).
     """
     E = lin.E if E is None else np.atleast_2d(np.asarray(E, dtype=float))
     n, p = lin.A.shape[0], lin.C.shape[0]
@@ -119,9 +124,13 @@ def decouple(plant: System, lin: Linearization, *, z1, w1, E=None, F=None) -> De
         raise ObserverError("decoupling: the disturbance E must act on subsystem 1 only and the faults F on "
                             "outputs of subsystem 2 only")
     C1, E1 = C[np.ix_(iw1, iz1)], E[list(iz1)]
-    if _rank(C1 @ E1) != _rank(E1):
-        raise ObserverError(f"decoupling: rank(C1 E1) = {_rank(C1 @ E1)} but rank(E1) = {_rank(E1)}: the "
-                            "disturbance cannot be decoupled from subsystem 1's outputs (no unknown-input observer)")
+    try:  # the unknown-input observer's two existence conditions (Chen & Patton), for subsystem 1
+        uio_conditions(A[np.ix_(iz1, iz1)], C1, E1, time="continuous")
+        undetectable = ()
+    except UIOConditionError as exc:
+        if exc.ranks is None or exc.ranks[0] != exc.ranks[1]:
+            raise ObserverError(f"decoupling: {exc}") from None
+        undetectable = exc.eigenvalues  # T A11 has modes C1 cannot see: no K1 stabilises them
     exact = {"C1": _rational(C1), "E1": _rational(E1)}
     CE = exact["C1"] * exact["E1"]
     exact["H"] = exact["E1"] * CE.pinv() if CE.rank() else sympy.zeros(len(iz1), len(iw1))
@@ -136,7 +145,7 @@ def decouple(plant: System, lin: Linearization, *, z1, w1, E=None, F=None) -> De
     return Decoupling(plant.name, tuple(z1), tuple(plant.x.names[i] for i in iz2), tuple(w1),
                       tuple(plant.y.names[i] for i in iw2), iz1, iz2, iw1, iw2, C1, C[np.ix_(iw2, iz2)],
                       F[list(iw2)], E1, _floats(exact["H"]), _floats(exact["Tu"]),
-                      {k: _floats(exact[k]) for k in blocks}, exact, ranks)
+                      {k: _floats(exact[k]) for k in blocks}, exact, ranks, tuple(undetectable))
 
 
 @dataclass(frozen=True)
