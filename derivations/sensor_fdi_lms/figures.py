@@ -43,18 +43,20 @@ def criteria_figure(outcome, path: Path) -> None:
 
 
 def heading_figure(outcomes: dict, path: Path, title: str, substitute: bool) -> None:
-    """Figs. 4a/4b: true (solid) and measured (faint) heading per fault; with ``substitute`` the
-    frozen filter's substitute (dashed) of the first run."""
+    """Figs. 4a/4b: true (solid) heading per fault; without ``substitute`` the measured one (faint),
+    with it the frozen filter's substitute (dashed) of the first run and the paper's +-3 deg band."""
     fig, ax = plt.subplots(figsize=(7, 3.8))
     for (label, outcome), colour in zip(outcomes.items(), ("C3", "C1", "C0")):
         w = _window(outcome)
         k = outcome.k[w]
-        ax.plot(k, np.degrees(outcome.result["y"]["psi"][w]), colour, lw=0.6, alpha=0.35)
+        if not substitute:
+            ax.plot(k, np.degrees(outcome.result["y"]["psi"][w]), colour, lw=0.6, alpha=0.35)
         ax.plot(k, outcome.heading_deg()[w], colour, lw=1.3, label=f"{label}: true heading")
     if substitute:
         outcome = next(iter(outcomes.values()))
         w = _window(outcome)
         ax.plot(outcome.k[w], np.degrees(outcome.monitor("psi_sub")[w]), "k--", lw=1, label="FIR substitute (first)")
+        ax.axhspan(SET_POINT_DEG - 3.0, SET_POINT_DEG + 3.0, color="grey", alpha=0.12, lw=0, label="+-3 deg")
     ax.axhline(SET_POINT_DEG, color="grey", lw=0.6)
     ax.axvline(FAULT_SAMPLE, color="k", lw=0.6, ls=":")
     ax.set_xlabel("recorded sample k (0.2 s)")

@@ -15,6 +15,7 @@ from derivations.sensor_fdi_lms.figures import criteria_figure, delay_figure, he
 from derivations.sensor_fdi_lms.observer_sets import lms_set
 from derivations.sensor_fdi_lms.study import R0_GRID, SIZE_DEG, WITHIN, detection_study
 from derivations.sensor_fdi_lms.text import report_text
+from uvsym.errors import SimulationError
 from uvsym.observers.lms import mu_bound
 from uvsym.report import write_json
 from uvsym.report.sections import c_package, claim_rows
@@ -28,6 +29,7 @@ SETTLED = 100  # samples (20 s) at the end of the record whose mean heading is t
 FTC_WINDOW = 300  # samples (60 s) after the onset over which the FTC error is taken
 FTC_SEEDS = tuple(range(8))  # noise seeds of the FTC robustness runs
 BANDWIDTHS = (0.35, D.BANDWIDTH, 1.4)  # rad/s, the proportional law's natural frequencies compared
+STEPS = (D.MU, 1e3, 1e4, 1e5)  # LMS steps compared (the paper's, and larger ones that let the filter learn)
 
 
 def _summary(outcome) -> dict:
@@ -88,6 +90,25 @@ def _robustness(progress) -> dict:
     return {"seeds": list(FTC_SEEDS), "over_seeds": seeds, "heading_laws": laws}
 
 
+def _steps(progress) -> list[dict]:
+    """Per mu of STEPS (+30 deg, FTC once confirmed, seed 0): prediction error before the fault and
+    the FTC error, or the time the loop diverged."""
+    rows = []
+    for mu in STEPS:
+        progress(f"LMS step mu = {mu:g}")
+        try:
+            outcome = run(Run(size_deg=30.0, mu=mu))
+        except SimulationError as exc:
+            rows.append({"mu": mu, "diverged": str(exc).split(";")[0]})
+            continue
+        k = outcome.k
+        before = (k >= 0) & (k < D.FAULT_SAMPLE)
+        error = np.degrees(outcome.monitor("e_psi")[before])
+        rows.append({"mu": mu, "rms_prediction_error_deg": float(np.sqrt(np.mean(error ** 2))),
+                     "max_abs_heading_error_deg": _summary(outcome)["max_abs_heading_error_deg"]})
+    return rows
+
+
 def _learning(u: np.ndarray, outcome) -> dict:
     """How much the filter learns: input power, mu M P_u, adaptation time, weights and prediction."""
     k = outcome.k
@@ -105,6 +126,7 @@ def build(out_dir: Path, progress) -> None:
     """Run the reproduction and the detection study, export C, check the claims, write the report."""
     outcomes, summaries = _runs(progress)
     robustness = _robustness(progress)
+    steps = _steps(progress)
     progress(f"detection study: {2 * 100} runs over noise seeds, ROC over thresholds")
     study = detection_study()
     progress("C package of the monitor: write, compile, compare")
@@ -131,7 +153,8 @@ def build(out_dir: Path, progress) -> None:
             "max_abs_heading_error_deg"] for size in ftc},
         "spike_classified_as": _classified(summaries["spike"]),
         "spike_substituted": summaries["spike"]["substituted_from_sample"] is not None,
-        "runs": summaries, "robustness": robustness, "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
+        "runs": summaries, "robustness": robustness, "steps": steps,
+        "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
         "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
                   "nominal": study.delays, "r0_grid": list(R0_GRID)},
         "paper": PAPER, "c": c, "claims": claims, "negative_factor": NEGATIVE_FACTOR,

@@ -93,6 +93,15 @@ turning the vehicle once the sensor is replaced by a prediction that does not se
 {laws}"""
 
 
+def _steps(r: dict) -> str:
+    rows = [[f"{row['mu']:g}", f"{r['learning']['input_power'] * row['mu'] * D.ORDER:.3g}",
+             f"{row['rms_prediction_error_deg']:.3f}" if "diverged" not in row else "-",
+             f"{row['max_abs_heading_error_deg']:.2f}" if "diverged" not in row else row["diverged"]]
+            for row in r["steps"]]
+    return markdown_table(["mu", "mu M P_u (healthy P_u)", "RMS prediction error before the fault (deg)",
+                           "max abs heading error with FTC, +30 deg (deg)"], rows)
+
+
 def report_text(r: dict, source) -> str:
     """The report (Markdown) from the results ``r`` and the paper ``source`` (derivations.papers.Paper)."""
     c, learning, study = r["choices"], r["learning"], r["study"]
@@ -178,6 +187,13 @@ error and commands nothing, and the heading error is the transient before the sw
 drift the yaw torque causes while the heading is not measured. The $\\varepsilon^2$ and $R$ criteria do
 not need a trained filter (a step in the measurement is a step in $e$).
 
+A larger step lets the filter learn, but there is little to learn: in heading hold the past
+commands predict the heading no better than the set-point does, and a filter trained on the loop's
+noise predicts worse. After the fault the controller's reaction raises the command's power, so a
+step below the healthy run's bound can be beyond the faulty run's (the last row):
+
+{_steps(r)}
+
 ### Fault-tolerant control: noise seeds and heading laws
 
 {_robustness(r)}
@@ -212,8 +228,8 @@ At the nominal thresholds:
 The step-size claim takes $P_u$ as the mean square of the healthy run's recorded command and decides
 $\\mu M P_u < 1$ in exact rational arithmetic on the samples' binary values (the mean-square bound of
 independence theory, Widrow & Stearns 1985, $\\operatorname{{tr}} R_{{UU}} = M P_u$). The negative control
-$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted as it must be: exact $\\mu M P_u$ = {r['negative_factor']:g}
-({negative['claim']}).
+$\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted as it must be: exact $\\mu M P_u$ =
+{1 - negative['margin']:g} (margin {negative['margin']:g}).
 `uvsym simulate` warns (`StepSizeWarning`, with the bound) when a scenario's $\\mu$ is at or beyond the
 bound of its own run.
 
