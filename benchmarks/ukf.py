@@ -138,7 +138,7 @@ def c_step_ns(observer, y, u) -> dict:
         n_s, n_out = observer.state.size, observer.publishes.size
         values = ", ".join(f"{v:.17g}" for v in s0)
         setup = f"""
-  static {name}_real s[{n_s}] = {{{values}}}, s_next[{n_s}], out[{n_out}], p[2] = {{0, 0}};
+  static {name}_real s[{n_s}] = {{{values}}}, s_next[{n_s}], out[{n_out}], p[1] = {{0}};  /* no parameters */
   static {name}_real y[6] = {{{", ".join(f"{v:.17g}" for v in y)}}}, u[2] = {{{u[0]:.17g}, {u[1]:.17g}}};"""
         wall_template = c_timing.TEMPLATE
         timings = {}

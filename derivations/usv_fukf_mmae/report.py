@@ -133,6 +133,8 @@ def _report(r: dict, scenario) -> str:
                f"{t['p_min']:g}; {', '.join(f'{p:g}' for p in t['prior'])} (no-fault, left, right)"],
               ["federated reset", "every sample, kinematic states to the fused estimate" if t["reset"] else "off"],
               ["measurements", "all six states (x, y, psi, u, v, r) with Gaussian noise"],
+              ["filters' model", "eqs. 1-3 in still water (no current parameters; the plant's current is 0), "
+                                 "RK4 over each sample as the plant"],
               ["controller", f"LOS (lookahead {scenario.path.lookahead:g} m, corners rounded at "
                              f"{scenario.path.turn_radius:g} m) + speed PI (feed-forward d11 U) + heading PID"]]
     noise = ", ".join(f"{k} {v:g}" for k, v in scenario.noise.items())

@@ -128,9 +128,12 @@ def cholesky(A) -> tuple[ca.SX, ca.SX]:
                                       -BOUND), BOUND)
     margin = ca.fmax(margin, -1.0)
     healthy = margin > 0.0
-    factor = [[ca.if_else(healthy, L[i][j], ca.sqrt(ca.fabs(A[i, i]) + 1.0)) if i == j
-               else healthy * L[i][j] for j in range(n)] for i in range(n)]
-    return ca.vertcat(*[ca.horzcat(*row) for row in factor]), margin
+    factor = ca.SX(ca.Sparsity.lower(n))  # structural zeros above the diagonal: shifts along late columns
+    for j in range(n):                      # leave the early states untouched (shared evaluations)
+        factor[j, j] = ca.if_else(healthy, L[j][j], ca.sqrt(ca.fabs(A[j, j]) + 1.0))
+        for i in range(j + 1, n):
+            factor[i, j] = healthy * L[i][j]
+    return factor, margin
 
 
 def _forward(L, B):

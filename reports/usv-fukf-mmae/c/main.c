@@ -8,7 +8,7 @@ int main(void) {
   static const uvsym_otter_ukf_mmae_real s[100] = {0};
   static const uvsym_otter_ukf_mmae_real y[6] = {0};
   static const uvsym_otter_ukf_mmae_real u[2] = {0};
-  static const uvsym_otter_ukf_mmae_real p[2] = {0};
+  const uvsym_otter_ukf_mmae_real* p = NULL;
   uvsym_otter_ukf_mmae_real s_next[100];
   uvsym_otter_ukf_mmae_real out[16];
   rc = uvsym_otter_ukf_mmae_ukf_bank_step(s, y, u, p, s_next, out);
