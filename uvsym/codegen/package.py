@@ -186,10 +186,11 @@ def _header(name: str, description: str, citation: str, precision: str, wrappers
 
 
 def _argument_entry(name: str, size: int, doc) -> dict:
-    """An argument in the manifest: name, size, unit (its line of text), entries and units (lists, or None)."""
+    """An argument in the manifest: name, size, what it is, unit (its whole line of text), entries and
+    units (lists, one per entry, or None for an argument documented by text only)."""
     entries = doc if isinstance(doc, Entries) else None
-    return {"name": name, "size": size, "unit": str(doc), "entries": list(entries.names) if entries else None,
-            "units": list(entries.units) if entries else None}
+    return {"name": name, "size": size, "what": entries.what if entries else str(doc), "unit": str(doc),
+            "entries": list(entries.names) if entries else None, "units": list(entries.units) if entries else None}
 
 
 def write_package(out_dir, functions: list[Exported], name: str, precision: str = "double",
@@ -227,8 +228,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     (out / "include" / f"{name}_casadi.h").write_text(header)
     wrappers = [_wrapper(e, name, finite_check) for e in functions]
     (out / "include" / f"{name}.h").write_text(_header(name, description, citation, precision, wrappers))
-    helper = _ALL_FINITE.format(package=name) + "\n" if finite_check else ""
-    (out / "src" / f"{name}.c").write_text(f'#include <math.h>\n#include "{name}.h"\n\n{helper}'
+    all_finite = _ALL_FINITE.format(package=name) + "\n" if finite_check else ""
+    (out / "src" / f"{name}.c").write_text(f'#include <math.h>\n#include "{name}.h"\n\n{all_finite}'
                                            + "\n".join(b for _, b in wrappers))
     (out / "main.c").write_text(example_program(functions, name, example))
     (out / "harness.c").write_text(harness_program(functions, name))

@@ -10,11 +10,11 @@ def _argument_rows(function: dict) -> list[str]:
     for direction, key in (("in", "inputs"), ("out", "outputs")):
         for argument in function[key]:
             if argument["units"] is None:
-                entries = argument["unit"]
+                entries = "(documented as text only)"
             else:
                 entries = ", ".join(f"{entry} [{unit}]" for entry, unit in
                                     zip(argument["entries"], argument["units"])) or "none"
-            rows.append(f"| {direction} | `{argument['name']}` | {argument['size']} | {entries} |")
+            rows.append(f"| {direction} | `{argument['name']}` | {argument['size']} | {argument['what']} | {entries} |")
     return rows
 
 
@@ -23,7 +23,7 @@ def _function_section(function: dict, real: str) -> str:
                  for a in function["inputs"]]
     arguments += [f"{real} {a['name']}[{a['size']}]" if a["size"] else f"{real}* {a['name']}"
                   for a in function["outputs"]]
-    table = ["| | argument | size | entries [unit] |", "|---|---|---|---|", *_argument_rows(function)]
+    table = ["| | argument | size | what | entries [unit] |", "|---|---|---|---|---|", *_argument_rows(function)]
     return (f"### `{function['c_function']}`\n\n{function['description']}.\n\n"
             f"```c\nint {function['c_function']}({', '.join(arguments)});\n```\n\n" + "\n".join(table) + "\n")
 
