@@ -27,6 +27,7 @@ __all__ = [
     "SetError",
     "SetDivergenceError",
     "UIOConditionError",
+    "StepSizeWarning",
 ]
 
 
