@@ -178,21 +178,22 @@ def test_check_package_compiles_compares_and_names_a_broken_source(tmp_path, obs
         check_package(tmp_path, functions, name, calls=3)
 
 
-def test_two_packages_with_the_same_function_name_link_into_one_program(tmp_path):
-    """Every external name carries the package's prefix: two packages that both export bias_step link together."""
+def test_two_packages_of_either_precision_link_into_one_program_from_one_source_file(tmp_path):
+    """Every external name carries the package's prefix and a package's header stands alone: a double and
+    a float package that both export bias_step are included by one source file and linked together."""
     x = ca.SX.sym("x", 2)
-    for package, expression in (("pkg_a", x + 1), ("pkg_b", 2 * ca.sin(x))):
+    for package, expression, precision in (("pkg_a", x + 1, "double"), ("pkg_b", 2 * ca.sin(x), "float")):
         function = ca.Function("bias_step", [x], [expression], ["x"], ["y"])
-        write_package(tmp_path / package, [Exported(function, ("x (-)",), ("y (-)",), "test")], package)
+        write_package(tmp_path / package, [Exported(function, ("x (-)",), ("y (-)",), "test")], package, precision)
     (tmp_path / "main.c").write_text("""#include <stdio.h>
 #include "pkg_a.h"
 #include "pkg_b.h"
 
 int main(void) {
   pkg_a_real x[2] = {0.5, 1.0}, a[2];
-  pkg_b_real b[2];
-  if (pkg_a_bias_step(x, a) || pkg_b_bias_step(x, b)) return 1;
-  printf("%.17g %.17g %.17g %.17g\\n", a[0], a[1], b[0], b[1]);
+  pkg_b_real xf[2] = {0.5f, 1.0f}, b[2];
+  if (pkg_a_bias_step(x, a) || pkg_b_bias_step(xf, b)) return 1;
+  printf("%.17g %.17g %.17g %.17g %d\\n", a[0], a[1], (double)b[0], (double)b[1], (int)sizeof b[0]);
   return 0;
 }
 """)
@@ -202,6 +203,6 @@ int main(void) {
     done = subprocess.run([find_compiler(), *STRICT, *includes, str(tmp_path / "main.c"), *sources, "-o", str(exe),
                            "-lm"], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    values = [float(v) for v in subprocess.run([str(exe)], capture_output=True, text=True).stdout.split()]
-    assert values == pytest.approx([1.5, 2.0, 2 * np.sin(0.5), 2 * np.sin(1.0)], rel=1e-15)
-
+    *values, float_size = [float(v) for v in subprocess.run([str(exe)], capture_output=True, text=True).stdout.split()]
+    assert values[:2] == pytest.approx([1.5, 2.0], rel=1e-15) and float_size == 4
+    assert values[2:] == pytest.approx([2 * np.sin(0.5), 2 * np.sin(1.0)], rel=1e-6)  # single precision
