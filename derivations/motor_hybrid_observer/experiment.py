@@ -112,12 +112,14 @@ def detection_time(run_: dict, detector: str, threshold: float) -> float | None:
 
 
 def run_cases() -> dict:
-    """The three runs, each detector's threshold (``THRESHOLD_FACTOR`` x its largest judged |r| in
-    fault-free runs with the calibration seeds' noise) and alarm times."""
+    """The runs, each detector's threshold (``THRESHOLD_FACTOR`` x its largest judged |r| in
+    fault-free runs with the calibration seeds' noise), alarm times, and the hybrid estimator's
+    final estimate (mean over the last second) in each calibration run."""
     runs = {name: run(profile) for name, profile in CASES.items()}
     runs["fault-free, observers start at the operating point"] = run(None, known_start=False)
     calibration = [run(None, seed=seed) for seed in CALIBRATION_SEEDS]
     thresholds = {det: THRESHOLD_FACTOR * max(float(np.max(np.abs(c[f"{det}_r_omega_m"][c["t"] >= CONVERGED_AFTER])))
                                               for c in calibration) for det in DETECTORS}
     detection = {det: {name: detection_time(r, det, thresholds[det]) for name, r in runs.items()} for det in DETECTORS}
-    return {"runs": runs, "thresholds": thresholds, "detection_time_s": detection}
+    wander = [float(np.mean(c["estimator_f_s_hat"][c["t"] >= DURATION - 1.0])) for c in calibration]
+    return {"runs": runs, "thresholds": thresholds, "detection_time_s": detection, "fault_free_final_estimates": wander}

@@ -130,6 +130,7 @@ def _results(cases: dict) -> dict:
         "corrected_case_b_final_error_analytic": b["true"] - b["corrected_analytic"],
         "unknown_start_estimate": estimates[UNKNOWN_START],
         "estimator_fault_free_final": _final(cases["runs"]["fault-free"], "estimator_f_s_hat"),
+        "estimator_fault_free_final_other_noise": cases["fault_free_final_estimates"],
         "paper_estimates": PAPER_ESTIMATES,
         "ranks": split.ranks,
         "H_minus_printed_max": float(np.max(np.abs(split.H - H_printed))),
