@@ -144,6 +144,14 @@ def test_bad_settings_are_typed_errors_naming_the_argument(argument, kwargs):
         monitor(**kwargs)
 
 
+def test_monitor_reads_exactly_one_sensor_and_one_input():
+    two = signals(("y1", "m"), ("y2", "m"), group="output")
+    with pytest.raises(ObserverError, match="measured must be one signal"):
+        lms_monitor(two, U, order=3, mu=0.1, eps0=1.0, r0=2.0, dt=0.1)
+    with pytest.raises(ObserverError, match="reference must be one signal"):
+        lms_monitor(Y, U, order=3, mu=0.1, eps0=1.0, r0=2.0, dt=0.1, reference=two)
+
+
 def test_step_size_bound_and_warning():
     assert mu_bound(70, 0.25) == pytest.approx(1 / 17.5)
     with warnings.catch_warnings():
@@ -193,6 +201,20 @@ def test_supervisor_substitutes_once_confirmed_and_logs():
     assert [e.sample for e in supervisor.events[:2]] == [2, 4]
     with pytest.raises(ObserverError, match="substitute_on"):
         SubstitutionSupervisor(obs, substitute_on="never")
+
+
+def test_supervisor_on_alarm_switches_in_at_the_freeze_and_back_at_the_release():
+    obs = monitor(M=2)
+    names = obs.publishes.names
+    supervisor = SubstitutionSupervisor(obs, substitute_on="alarm")
+    flags = np.zeros((1, len(names)))
+    decisions = []
+    for frozen, released in ((0, 0), (1, 0), (1, 0), (0, 1), (0, 0)):
+        flags[0, names.index("frozen_y")], flags[0, names.index("disturbance_y")] = frozen, released
+        decisions.append(supervisor.update(np.array([0.1 * len(decisions)]), {obs.name: flags.copy()}))
+    assert decisions[0] is None and decisions[1].channels == frozenset({"y"})
+    assert decisions[2] is None and decisions[3].channels == frozenset() and decisions[4] is None
+    assert supervisor.first("no R alarm").sample == 3
 
 
 @pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
