@@ -3,9 +3,8 @@
    Units in brackets; README.md describes the API. */
 #ifndef UVSYM_SENSOR_FDI_LMS_H
 #define UVSYM_SENSOR_FDI_LMS_H
-#include "uvsym_sensor_fdi_lms_casadi.h"
 
-typedef casadi_real uvsym_sensor_fdi_lms_real;
+typedef double uvsym_sensor_fdi_lms_real;
 
 /* return codes of every function below */
 #define UVSYM_SENSOR_FDI_LMS_OK 0 /* success: every output written */
