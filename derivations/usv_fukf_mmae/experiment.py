@@ -35,7 +35,7 @@ from uvsym.systems.signals import signals
 from uvsym.systems.system import System, system
 
 __all__ = ["MODELS", "TUNING", "disturbed_plant", "still_water", "guidance", "simulate_plant", "filters", "bank",
-           "run_banks", "run_scenario"]
+           "bank_signal", "run_banks", "run_scenario"]
 
 MODELS = {"nofault": (), "left": ("T_L",), "right": ("T_R",)}
 TUNING = {
@@ -138,21 +138,22 @@ def filters(scenario: Scenario, method: str) -> dict:
     return built
 
 
-def bank(scenario: Scenario, method: str):
-    """The MMAE bank (an Observer) of the three models, 'ukf' or 'ekf'."""
-    return mmae_bank(filters(scenario, method), name=f"{method}_bank", p_min=TUNING["p_min"], prior=TUNING["prior"],
-                     reset=TUNING["reset"])
+def bank(scenario: Scenario, method: str, p_min: float | None = None):
+    """The MMAE bank (an Observer) of the three models, 'ukf' or 'ekf' (floor p_min, default TUNING's)."""
+    return mmae_bank(filters(scenario, method), name=f"{method}_bank", p_min=p_min or TUNING["p_min"],
+                     prior=TUNING["prior"], reset=TUNING["reset"])
+
+
+def bank_signal(scenario: Scenario, result: SimResult, method: str, p_min: float | None = None) -> Signal:
+    """Everything the bank publishes, one row per sample of ``result`` (measurements y, commands T_bar)."""
+    obs = bank(scenario, method, p_min)
+    _, OUT = run_filter(obs, result["y"].values, result["guidance"].values)
+    return Signal(OUT, obs.publishes.names, obs.publishes.units)
 
 
 def run_banks(scenario: Scenario, result: SimResult) -> dict:
-    """method -> Signal of everything the bank publishes, one row per sample of ``result``."""
-    Y, U = result["y"].values, result["guidance"].values
-    out = {}
-    for method in ("ukf", "ekf"):
-        obs = bank(scenario, method)
-        _, OUT = run_filter(obs, Y, U)
-        out[method] = Signal(OUT, obs.publishes.names, obs.publishes.units)
-    return out
+    """method -> :func:`bank_signal` of the UKF and the EKF bank."""
+    return {method: bank_signal(scenario, result, method) for method in ("ukf", "ekf")}
 
 
 def run_scenario(scenario: Scenario, method: str | None = None, progress=None) -> SimResult:

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from derivations.usv_fukf_mmae import analysis as A
-from derivations.usv_fukf_mmae.experiment import GAINS, MODELS, TUNING, run_scenario
+from derivations.usv_fukf_mmae.experiment import GAINS, MODELS, TUNING, bank_signal, run_scenario
 from derivations.usv_fukf_mmae.figures import FIGURES, draw_all
 from derivations.usv_fukf_mmae.observer_sets import usv_fukf_mmae
 from derivations.usv_fukf_mmae.paper import CITATION, eq4_check, eq11_check, eq18_check
@@ -19,6 +19,7 @@ __all__ = ["build", "TARGETS"]
 
 SCENARIO = "otter_thruster_faults"
 RESOLUTION = 1e-3  # s or efficiency: differences below this are called equal
+FLOOR_CHECK = 1e-3  # the reproduction notes' proposed floor, run beside the chosen one
 TARGETS = {"p_nofault_min_outside_windows": ("> 0.9", lambda v: v is not None and v > A.THRESHOLD),
            "detect_delay_s": (f"<= {A.DETECT_WITHIN:g} s", lambda v: v is not None and v <= A.DETECT_WITHIN)}
 
@@ -55,6 +56,8 @@ def build(out_dir: Path, progress) -> None:
     merit = A.figures_of_merit(result, scenario)
     progress("figures")
     draw_all(result, scenario, out_dir)
+    progress(f"sensitivity: the UKF bank with the floor {FLOOR_CHECK:g}")
+    floor_check = A.bank_figures(result.t, bank_signal(scenario, result, "ukf", FLOOR_CHECK), scenario)
     progress("C package of the UKF bank: write, compile, compare")
     c = c_package(usv_fukf_mmae("ukf"), out_dir / "c")
     n = 6 + 1
@@ -63,8 +66,9 @@ def build(out_dir: Path, progress) -> None:
     ukf, ekf = result["ukf_bank"], result["ekf_bank"]
     results.update({"ukf_minus_ekf_max_abs": {name: float(np.max(np.abs(ukf[name] - ekf[name])))
                                               for name in ukf.labels if name.endswith("_hat") or name.startswith("p_")},
-                    "targets": rows, "banks": merit["banks"], "rms_error_outside_windows":
-                    merit["rms_error_outside_windows"], "tuning": TUNING, "controller_gains": GAINS,
+                    "targets": rows, "banks": merit["banks"], "ukf_bank_with_floor_1e-3": floor_check,
+                    "rms_error_outside_windows": merit["rms_error_outside_windows"], "tuning": TUNING,
+                    "controller_gains": GAINS,
                     "paper_checks": {"eq4": eq4_check(), "eq11": eq11_check(n, **TUNING["ukf"]),
                                      "eq18": eq18_check(n, 6)}, "c": c})
     write_json(out_dir / "results.json", results)
@@ -135,10 +139,12 @@ def _report(r: dict, scenario) -> str:
               ["measurements", "all six states (x, y, psi, u, v, r) with Gaussian noise"],
               ["filters' model", "eqs. 1-3 in still water (no current parameters; the plant's current is 0), "
                                  "RK4 over each sample as the plant"],
+              ["UKF update", "the measurement is affine in x (y = x): its unscented moments are exact and are "
+                             "evaluated in closed form; the prediction propagates 2n + 1 sigma points"],
               ["controller", f"LOS (lookahead {scenario.path.lookahead:g} m, corners rounded at "
                              f"{scenario.path.turn_radius:g} m) + speed PI (feed-forward d11 U) + heading PID"]]
     noise = ", ".join(f"{k} {v:g}" for k, v in scenario.noise.items())
-    diff = r["ukf_minus_ekf_max_abs"]
+    diff, floor = r["ukf_minus_ekf_max_abs"], r["ukf_bank_with_floor_1e-3"]
     diff_states = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.endswith("_hat") and "." not in k)
     diff_p = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.startswith("p_"))
     figures = "\n\n".join(f"![{text}]({name})\n\n*{text}.*" for name, text in FIGURES.items())
@@ -204,6 +210,13 @@ Largest difference between the two banks over the run (UKF minus EKF): fused sta
 filters' covariances stay small, and over such a spread the Otter's model is nearly linear: the
 unscented transform and the EKF's linearisation then predict almost the same, which is what these
 differences measure.
+
+The floor: with {FLOOR_CHECK:g} (the floor first proposed for this reproduction) instead of {t['p_min']:g},
+the UKF bank's lowest p_nofault outside the windows is {floor['p_nofault_min_outside_windows']:.4g} instead of
+{r['p_nofault_min_outside_windows']:.4g} (delays {", ".join(_fmt(f["detect_delay_s"]) + " s" for f in floor["faults"])}).
+On healthy stretches a fault model whose efficiency stays near 1 explains the disturbance about
+as well as the no-fault model, so its probability drifts up from the floor by chance; the higher
+the floor, the fewer samples such a drift needs to take a visible share.
 
 RMS error of the fused estimate outside the fault windows:
 

@@ -3,9 +3,8 @@
    Units in brackets; README.md describes the API. */
 #ifndef UVSYM_OTTER_UKF_MMAE_H
 #define UVSYM_OTTER_UKF_MMAE_H
-#include "uvsym_otter_ukf_mmae_casadi.h"
 
-typedef casadi_real uvsym_otter_ukf_mmae_real;
+typedef double uvsym_otter_ukf_mmae_real;
 
 /* return codes of every function below */
 #define UVSYM_OTTER_UKF_MMAE_OK 0 /* success: every output written */
