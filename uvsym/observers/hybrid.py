@@ -186,14 +186,16 @@ def hybrid_observer(plant: System, dec: Decoupling, K1, L, dt: float, *, estimat
                     faults: Signals | None = None, name: str = "hybrid", steps: int = 1) -> Observer:
     """The observer of the module docstring for gains K1 (n1, p1) and L (n2, p2), sampled every dt (s).
 
-    State (v, zhat2, q); publishes ``<x>_hat`` for every state, ``r_<y>`` for every output (subsystem
-    1's ``omega1 - C1 zhat1``, subsystem 2's r) and, with an estimator, ``<fault>_hat`` (``faults``
-    names the q faults, default ``f_1 ...``). Starts at the operating point."""
+    State (v, zhat2, and the integral of r with an estimator); publishes ``<x>_hat`` for every state,
+    ``r_<y>`` for every output (subsystem 1's ``omega1 - C1 zhat1``, subsystem 2's r) and, with an
+    estimator, ``<fault>_hat`` (``faults`` names the q faults, default ``f_1 ...``). Starts at the
+    operating point."""
     check_name(name, "observer")
     n1, n2, p1, p2 = len(dec.iz1), len(dec.iz2), len(dec.iw1), len(dec.iw2)
     K1, L = _gain(K1, (n1, p1), "K1", name), _gain(L, (n2, p2), "L", name)
     GM1, GM2, N = _estimator(estimator, dec, name)
     q = dec.F2.shape[1] if estimator is not None else 0
+    n_int = p2 if q else 0  # the estimator integrates r (p2 entries)
     if faults is None:
         faults = signals(*((f"f_{j + 1}", "", f"sensor fault {j + 1}") for j in range(q)), group="fault")
     if faults.size != q:
@@ -205,8 +207,9 @@ def hybrid_observer(plant: System, dec: Decoupling, K1, L, dt: float, *, estimat
         v, zhat2, qint = s[:n1], s[n1:n1 + n2], s[n1 + n2:]
         w1, w2 = y[list(dec.iw1)], y[list(dec.iw2)]
         zhat1 = v + ca.mtimes(ca.DM(dec.H), w1)
-        r2 = ca.mtimes(ca.DM(N), w2 - ca.mtimes(ca.DM(dec.C4), zhat2)
-                       - ca.mtimes(ca.DM(dec.F2 @ GM1), qint) if q else w2 - ca.mtimes(ca.DM(dec.C4), zhat2))
+        r2 = w2 - ca.mtimes(ca.DM(dec.C4), zhat2)
+        if q:
+            r2 = ca.mtimes(ca.DM(N), r2 - ca.mtimes(ca.DM(dec.F2 @ GM1), qint))
         xhat = ca.SX.zeros(plant.x.size)
         xhat[list(dec.iz1)] = zhat1
         if n2:
@@ -231,11 +234,11 @@ def hybrid_observer(plant: System, dec: Decoupling, K1, L, dt: float, *, estimat
 
     def init(y0, u0, _p):
         v0 = x_op[list(dec.iz1)] - dec.H @ np.asarray(y0)[list(dec.iw1)]
-        return np.concatenate([v0, x_op[list(dec.iz2)], np.zeros(q)])
+        return np.concatenate([v0, x_op[list(dec.iz2)], np.zeros(n_int)])
 
     state = Signals(tuple(f"v_{n}" for n in dec.z1) + tuple(f"{n}_hat" for n in dec.z2) +
-                    tuple(f"int_r_{dec.w2[j]}" for j in range(q)), tuple(plant.x.units[i] for i in dec.iz1) +
-                    tuple(plant.x.units[i] for i in dec.iz2) + tuple(f"{plant.y.units[i]} s" for i in dec.iw2[:q]),
+                    tuple(f"int_r_{dec.w2[j]}" for j in range(n_int)), tuple(plant.x.units[i] for i in dec.iz1) +
+                    tuple(plant.x.units[i] for i in dec.iz2) + tuple(f"{plant.y.units[i]} s" for i in dec.iw2[:n_int]),
                     group="state")
     kind = "fault estimator (eq. 18)" if q else ("detection observer (eq. 6)" if n2 else "unknown-input observer")
     return observer(name, step=step, dt=dt, p0=plant.p0, params=plant.p.renamed(group="parameter"), state=state,
@@ -248,7 +251,8 @@ def hybrid_observer(plant: System, dec: Decoupling, K1, L, dt: float, *, estimat
 
 def observer_state(dec: Decoupling, xhat, C, q: int = 0) -> np.ndarray:
     """The state (v, zhat2, 0) of :func:`hybrid_observer` whose estimate is ``xhat`` (n,) when the
-    outputs read ``C xhat`` (C the plant's (p, n) output matrix); q faults estimated."""
+    outputs read ``C xhat`` (C the plant's (p, n) output matrix); q integral states (p2 for an
+    estimator, else 0), started at 0."""
     xhat = np.asarray(xhat, dtype=float).ravel()
     w1 = (np.asarray(C, dtype=float) @ xhat)[list(dec.iw1)]
     return np.concatenate([xhat[list(dec.iz1)] - dec.H @ w1, xhat[list(dec.iz2)], np.zeros(q)])
