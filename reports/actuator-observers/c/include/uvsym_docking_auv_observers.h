@@ -3,9 +3,8 @@
    Units in brackets; README.md describes the API. */
 #ifndef UVSYM_DOCKING_AUV_OBSERVERS_H
 #define UVSYM_DOCKING_AUV_OBSERVERS_H
-#include "uvsym_docking_auv_observers_casadi.h"
 
-typedef casadi_real uvsym_docking_auv_observers_real;
+typedef double uvsym_docking_auv_observers_real;
 
 /* return codes of every function below */
 #define UVSYM_DOCKING_AUV_OBSERVERS_OK 0 /* success: every output written */

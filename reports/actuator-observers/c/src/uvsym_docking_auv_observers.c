@@ -1,4 +1,5 @@
 #include <math.h>
+#include "uvsym_docking_auv_observers_casadi.h"
 #include "uvsym_docking_auv_observers.h"
 
 /* 1 when the n entries of v are all finite (not NaN, not infinite), else 0 */

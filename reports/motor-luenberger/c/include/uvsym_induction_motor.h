@@ -2,9 +2,8 @@
    Units in brackets; README.md describes the API. */
 #ifndef UVSYM_INDUCTION_MOTOR_H
 #define UVSYM_INDUCTION_MOTOR_H
-#include "uvsym_induction_motor_casadi.h"
 
-typedef casadi_real uvsym_induction_motor_real;
+typedef double uvsym_induction_motor_real;
 
 /* return codes of every function below */
 #define UVSYM_INDUCTION_MOTOR_OK 0 /* success: every output written */
