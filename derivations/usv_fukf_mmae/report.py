@@ -145,6 +145,7 @@ def _report(r: dict, scenario) -> str:
                              f"{scenario.path.turn_radius:g} m) + speed PI (feed-forward d11 U) + heading PID"]]
     noise = ", ".join(f"{k} {v:g}" for k, v in scenario.noise.items())
     diff, floor = r["ukf_minus_ekf_max_abs"], r["ukf_bank_with_floor_1e-3"]
+    floor_delays = ", ".join(f"{_fmt(f['detect_delay_s'])} s" for f in floor["faults"])
     diff_states = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.endswith("_hat") and "." not in k)
     diff_p = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.startswith("p_"))
     figures = "\n\n".join(f"![{text}]({name})\n\n*{text}.*" for name, text in FIGURES.items())
@@ -213,7 +214,7 @@ differences measure.
 
 The floor: with {FLOOR_CHECK:g} (the floor first proposed for this reproduction) instead of {t['p_min']:g},
 the UKF bank's lowest p_nofault outside the windows is {floor['p_nofault_min_outside_windows']:.4g} instead of
-{r['p_nofault_min_outside_windows']:.4g} (delays {", ".join(_fmt(f["detect_delay_s"]) + " s" for f in floor["faults"])}).
+{r['p_nofault_min_outside_windows']:.4g} (delays {floor_delays}).
 On healthy stretches a fault model whose efficiency stays near 1 explains the disturbance about
 as well as the no-fault model, so its probability drifts up from the floor by chance; the higher
 the floor, the fewer samples such a drift needs to take a visible share.
