@@ -75,7 +75,9 @@ def test_exact_semidefinite_agrees_with_eigenvalues_on_random_rational_matrices(
     (np.eye(2), [("e1", [[1.0]]), ("e1", [[1.0]])], 0.0, "distinct"),
     (np.eye(2), [("e1", [[np.nan]]), ("e2", [[1.0]])], 0.0, "block 'e1'.*finite"),
     (np.eye(2), [("e1", [[1.0]]), ("e2", "C")], 0.0, "block 'e2'"),
-    (np.eye(2), [("e1", [[1.0]]), ("e2", [[1.0]])], -1.0, "decay"),
+    (np.eye(2), [("e1", [[1.0]]), ("e2", [[1.0]])], -1.0, "decay must be >= 0"),
+    (np.eye(2), [("e1", [[1.0]]), ("e2", [[1.0]])], float("inf"), "decay must be a finite number"),
+    (np.eye(2), [("e1", [[1.0]]), ("e2", [[1.0]])], "fast", "decay must be a finite number"),
     (np.eye(2), [("e1", [[1.0]]), ("e2", np.zeros((0, 1)))], 0.0, "block 'e2'.*no rows"),
 ])
 def test_mismatched_blocks_are_typed_errors_naming_the_block(omega, blocks, decay, message):

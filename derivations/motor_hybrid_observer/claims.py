@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 import sympy
 
 from derivations.motor_hybrid_observer.design import CORRECTED_DECAY, design
@@ -95,9 +94,3 @@ def hybrid_claims() -> list:
                           expected="refuted"),
     ]
 
-
-def corrected_eigenvalues() -> np.ndarray:
-    """Eigenvalues (1/s) of the corrected design's linearised error matrix, sorted by real part."""
-    d = design()
-    lin = d.corrected_plant.linearize()
-    return np.array(sorted(np.linalg.eigvals(lin.A - d.corrected.K[0] @ lin.C), key=lambda v: (v.real, v.imag)))

@@ -65,9 +65,11 @@ class BlockLMI:
         return [sum(self.sizes[:i]) for i in range(len(self.sizes))]
 
     def float_omega(self) -> np.ndarray:
+        """Omega (n, n) as doubles (for the solver; the checks use the exact entries)."""
         return np.array([[float(v) for v in row] for row in self.omega])
 
     def float_output(self, i: int) -> np.ndarray:
+        """C_i (p_i, n_i) as doubles."""
         return np.array([[float(v) for v in row] for row in self.outputs[i]]).reshape(-1, self.sizes[i])
 
 
@@ -115,7 +117,7 @@ def block_lmi(omega, blocks, decay: float = 0.0) -> BlockLMI:
     outputs = []
     for name, C in blocks:
         if isinstance(C, np.ndarray) and C.ndim == 2 and C.shape[0] == 0:
-            raise LMIError(f"block {name!r}: a C with no rows cannot tell its size; give a (0, n_i) list instead")
+            raise LMIError(f"block {name!r}: a C with no rows cannot tell its size; give a zero row (no injection)")
         outputs.append(_exact(C, f"block {name!r}: output matrix C"))
     sizes = [len(C[0]) if C and C[0] else 0 for C in outputs]
     if any(s == 0 for s in sizes):
@@ -127,10 +129,10 @@ def block_lmi(omega, blocks, decay: float = 0.0) -> BlockLMI:
                        f"({len(Om)}, {len(Om[0]) if Om else 0})")
     try:
         alpha = Fraction(float(decay))
-    except (TypeError, ValueError):
-        raise LMIError(f"decay must be a number (1/s), got {decay!r}") from None
-    if not (np.isfinite(float(decay)) and alpha >= 0):
-        raise LMIError(f"decay must be finite and >= 0 (1/s), got {decay}")
+    except (TypeError, ValueError, OverflowError):
+        raise LMIError(f"decay must be a finite number (1/s), got {decay!r}") from None
+    if alpha < 0:
+        raise LMIError(f"decay must be >= 0 (1/s), got {decay}")
     return BlockLMI(tuple(names), tuple(tuple(r) for r in Om), tuple(tuple(tuple(r) for r in C) for C in outputs),
                     tuple(sizes), alpha)
 
