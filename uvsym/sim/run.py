@@ -243,7 +243,7 @@ def check_memory(needed: int, what: str, error: type[UvsymError] = SimulationErr
     """``error`` with both figures when ``needed`` bytes exceed what the machine has available."""
     available = available_memory()
     if available is not None and needed > available:
-        raise error(f"{what} needs {_bytes(needed)} of memory, {_bytes(available)} are available; shorten the "
+        raise error(f"{what} needs at least {_bytes(needed)} of memory, {_bytes(available)} are available; shorten the "
                     "run or lengthen the step")
 
 
