@@ -40,6 +40,7 @@ def _summary(outcome) -> dict:
     switched = outcome.supervisor.first("substitution on")
     return {"eps2_first_alarm_sample": first_sample(outcome.monitor("alarm_eps2_psi"), k),
             "R_first_alarm_sample": first_sample(outcome.monitor("alarm_R_psi"), k, D.FAULT_SAMPLE),
+            "R_first_above_sample": first_sample(outcome.monitor("R_psi") > D.R0, k, D.FAULT_SAMPLE),
             "confirmed_sample": None if confirmed is None else confirmed.sample - outcome.spec.warm_up,
             "substituted_from_sample": None if switched is None else switched.sample + 1 - outcome.spec.warm_up,
             "settled_heading_deg": float(np.mean(heading[-SETTLED:])),
@@ -147,6 +148,7 @@ def build(out_dir: Path, progress) -> None:
     results = {
         "eps2_first_alarm_sample": paper_run["eps2_first_alarm_sample"],
         "R_first_alarm_sample": paper_run["R_first_alarm_sample"],
+        "R_first_above_threshold_sample": paper_run["R_first_above_sample"],
         "heading_without_ftc_deg": {size: summaries[size]["no_ftc"]["settled_heading_deg"] for size in ftc},
         "max_abs_heading_error_with_ftc_deg": ftc,
         "max_abs_heading_error_with_ftc_on_alarm_deg": {size: summaries[size]["ftc_on_alarm"][

@@ -122,6 +122,11 @@ one CasADi step (simulated, exported as C below); the decision is
 
 {markdown_table(["quantity", "reproduced", "paper", "target", "status"], _targets(r))}
 
+$R$ first exceeds $r_0$ at sample {r['R_first_above_threshold_sample']}, the first sample whose window holds
+the filter updated on the faulty sample; its alarm needs {D.HOLD} samples in a row above $r_0$ (see
+Method), so {r['R_first_above_threshold_sample'] + D.HOLD - 1} is the earliest it can come (the paper does not say
+what sets its own lag of 5 samples).
+
 The FTC rows use the rule of the issue this study answers: substitute once the double criterion
 confirms the fault (so that a disturbance never switches the sensor). The paper's own experiment
 (Sec. 4.3, L625-630) substitutes from the first $\\varepsilon^2$ alarm; with that rule the largest
@@ -166,6 +171,8 @@ R(k) = \\frac{{(S_k - \\bar S)^2}}{{\\operatorname{{var}} S}} \\text{{ over }} S
 
 ## Set-up (uvsym's choices; the paper gives none of these)
 
+- **Fault**: the paper's "fixed drift" fault is a constant added to the measured heading from sample
+  70 on (L508-521): uvsym's sensor fault kind `bias` with a step profile.
 - **Vehicle**: the Outland 1000's parameters are not published; `uvsym.plant("rov_yaw")`, the VideoRay Pro
   III yaw (Wang 2006), thrust command $u \\in [-1, 1]$, sample period {D.DT:g} s (L563).
 - **Controller**: the paper's PID (gains not given) as a proportional law $u = k_p (r - y)$,
