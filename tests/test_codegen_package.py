@@ -276,3 +276,12 @@ def test_the_documented_rk4_stability_bound_of_the_exported_steps(docking):
         factor = (moved - base) / delta
         np.testing.assert_allclose(factor, 1 - z + z**2 / 2 - z**3 / 6 + z**4 / 24, rtol=1e-6)
         assert (np.abs(factor) < 1).all() == (z < 2.78)
+
+
+def test_a_package_of_empty_arguments_compiles_without_an_unused_finite_check(tmp_path):
+    function = ca.Function("nothing", [ca.SX.sym("x", 0)], [ca.SX.sym("y", 0)], ["x"], ["y"])
+    write_package(tmp_path, [Exported(function, ("x (-)",), ("y (-)",), "empty")], "empty")
+    done = subprocess.run([find_compiler(), *STRICT, "-c", "-I", str(tmp_path / "include"),
+                           str(tmp_path / "src" / "empty.c"), "-o", str(tmp_path / "empty.o")], capture_output=True,
+                          text=True)
+    assert done.returncode == 0, done.stderr

@@ -229,7 +229,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     (out / "include" / f"{name}_casadi.h").write_text(header)
     wrappers = [_wrapper(e, name, finite_check) for e in functions]
     (out / "include" / f"{name}.h").write_text(_header(name, description, citation, precision, wrappers))
-    all_finite = _ALL_FINITE.format(package=name) + "\n" if finite_check else ""
+    checked = finite_check and any(d for e in functions for _, _, d, _ in e.arguments())  # an entry to check
+    all_finite = _ALL_FINITE.format(package=name) + "\n" if checked else ""
     includes = f'#include <math.h>\n#include "{name}_casadi.h"\n#include "{name}.h"\n\n'
     (out / "src" / f"{name}.c").write_text(includes + all_finite + "\n".join(b for _, b in wrappers))
     (out / "main.c").write_text(example_program(functions, name, example))
