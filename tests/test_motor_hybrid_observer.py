@@ -9,7 +9,9 @@ from derivations.motor_hybrid_observer.analysis import estimate, estimator_model
 from derivations.motor_hybrid_observer.claims import hybrid_claims
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_hybrid_observer.experiment import CASES, detection_time, run
+from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from uvsym.errors import ModelError, VerificationError
+from uvsym.report.sections import c_package
 
 
 def test_every_claim_has_its_expected_status_and_refutations_carry_evidence():
@@ -70,3 +72,10 @@ def test_hybrid_detects_both_faults_and_the_baseline_misses_the_incipient_one(sh
     late = b["t"] > 1.8
     assert np.mean(b["corrected_f_s_hat"][late]) == pytest.approx(1.0, abs=0.01)
     assert np.mean(b["estimator_f_s_hat"][late]) == pytest.approx(step_limit(), abs=0.01)
+
+
+def test_the_four_observers_export_to_C_that_matches_python(tmp_path):
+    c = c_package(motor_hybrid(), tmp_path / "c")
+    assert c["functions"] == [f"uvsym_motor_hybrid_{n}_step" for n in ("detection", "estimator", "baseline",
+                                                                       "corrected")]
+    assert c["compiled"] and "-Werror" in c["flags"] and c["max_relative_difference"] <= 1e-12

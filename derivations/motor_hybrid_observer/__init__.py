@@ -2,10 +2,12 @@
 unknown-input / adaptive observer, its LMI theorems checked by machine (refuted for this motor, with
 exact evidence) and a corrected design that uvsym proves.
 
-``uvsym report motor-hybrid-observer``, ``uvsym verify motor-hybrid-observer``.
+``uvsym report motor-hybrid-observer``, ``uvsym verify motor-hybrid-observer``,
+``uvsym codegen motor-hybrid-observer -o DIR``.
 """
 
 from derivations.motor_hybrid_observer.claims import hybrid_claims
+from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from derivations.motor_hybrid_observer.report import build
 from uvsym.derivation import Derivation
 
@@ -16,4 +18,5 @@ DERIVATION = Derivation(
     title="Incipient speed-sensor faults: hybrid unknown-input / adaptive observer, LMIs machine-checked",
     build=build,
     claims=hybrid_claims,
+    observer_sets={"motor-hybrid-observer": motor_hybrid},
 )

@@ -11,9 +11,10 @@ from derivations.motor_hybrid_observer.analysis import corrected_model, estimate
 from derivations.motor_hybrid_observer.claims import hybrid_claims
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_hybrid_observer.experiment import CASES, DURATION, run_cases
+from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from derivations.motor_hybrid_observer.text import report_text
 from uvsym.report import save_svg, write_json
-from uvsym.report.sections import claim_rows
+from uvsym.report.sections import c_package, claim_rows
 
 __all__ = ["build"]
 
@@ -160,7 +161,9 @@ def build(out_dir: Path, progress) -> None:
     cases = run_cases()
     progress("figures")
     figures = _figures(cases, out_dir)
-    results = _results(cases) | {"claims": claim_rows(claims),
+    progress("C package of the four observers: write, compile, compare")
+    c = c_package(motor_hybrid(), out_dir / "c")
+    results = _results(cases) | {"c": c, "claims": claim_rows(claims),
                                  "claim_evidence": [c.counterexample for c in claims]}
     write_json(out_dir / "results.json", results)
     (out_dir / "report.md").write_text(report_text(results, figures))

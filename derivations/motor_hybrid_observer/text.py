@@ -20,7 +20,7 @@ from derivations.motor_luenberger.experiment import (
     THRESHOLD_FACTOR,
 )
 from uvsym.report import markdown_table
-from uvsym.report.sections import claims_table
+from uvsym.report.sections import c_section, claims_table
 
 __all__ = ["report_text"]
 
@@ -196,6 +196,10 @@ after {DURATION:g} s ({wander} rad/s with the calibration runs' noise draws); th
 the noise level.
 
 {figs}
+
+## Generated C
+
+{c_section(r["c"], "The four observers' steps (detection, estimator, baseline, corrected)")}
 
 ## Choices where the paper is silent
 
