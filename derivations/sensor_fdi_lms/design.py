@@ -91,17 +91,12 @@ def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0:
     ``integral``: the PI law of :func:`pi_gains` instead of the proportional one."""
     plant = uvsym.plant("rov_yaw")
     monitor = lms_monitor(plant.y, plant.u, reference=signals(("psi_ref", "rad", "heading set-point")),
-                          order=order, mu=mu, eps0=_positive_deg2(eps0_deg2), r0=r0, dt=DT, window=window,
+                          order=order, mu=mu, eps0=eps0_deg2 * (math.pi / 180.0) ** 2, r0=r0, dt=DT, window=window,
                           hold=hold, confirm=confirm, name="lms")
     kp, ki = pi_gains(plant) if integral else (heading_gain(plant, bandwidth), 0.0)
     reference = open_loop("reference", [0.0], [math.radians(set_point_deg)], publishes=["psi_ref"])
     controller = pid("heading", "psi", "psi_ref", output="u", kp=kp, ki=ki, limits=(-1.0, 1.0), dt=DT)
     return Design(plant, monitor, kp, (reference, controller, observer_block(monitor)))
-
-
-def _positive_deg2(value: float) -> float:
-    """deg^2 -> rad^2 (the monitor checks the sign and names eps0)."""
-    return float(value) * (math.pi / 180.0) ** 2 if isinstance(value, (int, float)) else value
 
 
 def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:

@@ -111,7 +111,7 @@ def _steps(progress) -> list[dict]:
 
 
 def _learning(u: np.ndarray, outcome) -> dict:
-    """How much the filter learns: input power, mu M P_u, adaptation time, weights and prediction."""
+    """How much the filter learns: input power, mu M P_u, adaptation time, prediction error before the fault."""
     k = outcome.k
     before = (k >= 0) & (k < D.FAULT_SAMPLE)
     deviation = np.degrees(outcome.result["y"]["psi"][before]) - D.SET_POINT_DEG

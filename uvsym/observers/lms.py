@@ -11,7 +11,7 @@ An FIR filter of order M predicts a sensor from the past inputs, trained by LMS 
     R_k   = (S_k - mean W_k)^2 / var W_k                    weight-drift criterion (eqs. 9-11), alarm when
                                                             R > r0 on the last ``hold`` samples
 
-Two choices where the paper is silent or garbled (each stated in the report that uses it): the
+Choices where the paper is silent or garbled (each stated in the report that uses it): the
 paper prints ``C + 2 mu e u`` with ``e = d - y``, which climbs the squared error; the step here
 descends it. The paper's ``u(k + 1 - i)`` starts at ``u(k)``; in a sampled loop u_k is computed
 from y_k, so a substitute built from u_k would feed back on itself within the sample: the
@@ -50,9 +50,7 @@ from uvsym.observers.base import Observer, check_name, observer
 from uvsym.observers.lms_supervisor import DECISION_STATE, double_criterion
 from uvsym.systems.signals import Signals, signals
 
-__all__ = ["LMS_PARAMETERS", "lms_step", "lms_monitor", "mu_bound", "check_mu"]
-
-LMS_PARAMETERS = ("mu", "eps0", "r0")
+__all__ = ["lms_step", "lms_monitor", "mu_bound", "check_mu"]
 
 
 def _positive_int(value, what: str, name: str) -> int:
