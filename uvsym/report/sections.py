@@ -59,7 +59,8 @@ def c_package(observers: ObserverSet, folder: Path) -> dict:
 def c_section(c: dict, subject: str) -> str:
     """The report's paragraph on a package from :func:`c_package`; ``subject`` opens it ("The observers ...")."""
     package = c["folder"]
-    links = (f"[header](<{package}/include/{c['package']}.h>), [sources](<{package}/src/>), "
+    links = (f"[README](<{package}/README.md>) (API, units, build, return codes), "
+             f"[header](<{package}/include/{c['package']}.h>), [sources](<{package}/src/>), "
              f"[Makefile](<{package}/Makefile>), [CMakeLists.txt](<{package}/CMakeLists.txt>), "
              f"[example](<{package}/main.c>), [manifest](<{package}/manifest.json>)")
     if c["compiled"]:
