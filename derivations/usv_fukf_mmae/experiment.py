@@ -31,17 +31,17 @@ from uvsym.sim import simulate_system
 from uvsym.sim.blocks import block
 from uvsym.sim.controllers import Autopilot, Loop
 from uvsym.sim.result import Signal, SimResult
+from uvsym.symbolic import rk4
 from uvsym.systems.signals import signals
 from uvsym.systems.system import System, system
 
-__all__ = ["MODELS", "TUNING", "disturbed_plant", "still_water", "guidance", "simulate_plant", "filters", "bank",
-           "bank_signal", "run_banks", "run_scenario"]
+__all__ = ["MODELS", "TUNING", "disturbed_plant", "still_water", "process_noise", "guidance", "simulate_plant",
+           "filters", "bank", "bank_signal", "run_banks", "run_scenario"]
 
 MODELS = {"nofault": (), "left": ("T_L",), "right": ("T_R",)}
 TUNING = {
     "ukf": {"alpha": 1.0, "beta": 2.0, "kappa": 0.0},
     "alpha_walk_std": 0.005,  # per sample, of the efficiency random walk
-    "eta_std": (0.01, 0.01, 0.002),  # m, m, rad per sample: modelling slack of the kinematics
     "P0_std": (0.5, 0.5, 0.05, 0.1, 0.1, 0.05, 0.2),  # x, y, psi, u, v, r, alpha
     "p_min": 1e-4,
     "prior": (0.98, 0.01, 0.01),  # nofault, left, right: the boat leaves healthy
@@ -113,16 +113,37 @@ def still_water(vehicle: str) -> System:
                   u_max=base.u_max, constants=base.constants, source=f"{base.source}; V_c = 0")
 
 
+def process_noise(scenario: Scenario) -> np.ndarray:
+    """Q (6, 6) of the kinematic states: the disturbance's covariance ``alpha_d^2 / 3`` (uniform
+    draws) through the sampled plant, ``G diag(alpha_d^2 / 3) G^T`` with ``G = dx_{k+1} / dtau_d``
+    (casadi.jacobian of the RK4 step) at the set speed. The position block rotates with the
+    heading: both positions get the largest variance over headings, their correlations with the
+    other states are dropped; ``1e-12 I`` keeps Q positive definite."""
+    plant, first = disturbed_plant(), scenario.path.segments()[0]
+    x, d = ca.SX.sym("x", 6), ca.SX.sym("d", 3)
+    u = ca.DM.zeros(plant.u.size)
+    step = rk4(lambda s, _t: plant.f(s, u, d, plant.p0), x, scenario.dt, 1)
+    jac = ca.Function("G", [x, d], [ca.jacobian(step, d)])
+    spread = np.diag(np.asarray(scenario.alpha_d) ** 2 / 3.0)
+
+    def at(psi):
+        G = np.asarray(jac([0.0, 0.0, psi, scenario.speed, 0.0, 0.0], np.zeros(3)))
+        return G @ spread @ G.T
+
+    Q = at(first["angle"])
+    Q[:2, :] = Q[:, :2] = 0.0
+    Q[0, 0] = Q[1, 1] = max(float(np.max(np.diag(at(psi))[:2])) for psi in np.linspace(0.0, np.pi, 9))
+    return Q + 1e-12 * np.eye(6)
+
+
 def filters(scenario: Scenario, method: str) -> dict:
     """model name -> GaussianFilter ('ukf' or 'ekf') with the tuning of TUNING.
 
-    Q: the disturbance's effect over one sample on the velocities, ``(dt M^-1)^2 alpha_d^2 / 3``
-    (variance of the uniform draw), plus TUNING's kinematic slack and efficiency walk; R the
-    sensor noise variances; P0 from TUNING; x0 the start of the path.
+    Q: :func:`process_noise` for the kinematic states, TUNING's random walk for the efficiency;
+    R the sensor noise variances; P0 from TUNING; x0 the start of the path.
     """
-    base, M = still_water(scenario.vehicle), uvsym.vehicle(scenario.vehicle).M
-    velocity_var = (scenario.dt / np.diag(M)) ** 2 * np.asarray(scenario.alpha_d) ** 2 / 3.0
-    q = np.concatenate([np.asarray(TUNING["eta_std"]) ** 2, velocity_var])
+    base = still_water(scenario.vehicle)
+    Q_kinematic = process_noise(scenario)
     R = np.array([scenario.noise[s] for s in STATES]) ** 2
     first = scenario.path.segments()[0]
     x0 = np.array([*first["start"], first["angle"], scenario.speed, 0.0, 0.0])
@@ -130,7 +151,9 @@ def filters(scenario: Scenario, method: str) -> dict:
     for model, thrusters in MODELS.items():
         plant = efficiency_augmented(base, thrusters) if thrusters else base
         extra = len(thrusters)
-        options = dict(dt=scenario.dt, Q=np.concatenate([q, [TUNING["alpha_walk_std"] ** 2] * extra]), R=R,
+        Q = np.zeros((6 + extra, 6 + extra))
+        Q[:6, :6], Q[6:, 6:] = Q_kinematic, TUNING["alpha_walk_std"] ** 2 * np.eye(extra)
+        options = dict(dt=scenario.dt, Q=Q, R=R,
                        P0=np.asarray(TUNING["P0_std"][:6 + extra]) ** 2, x0=np.concatenate([x0, np.ones(extra)]),
                        name=model)
         built[model] = (unscented_filter(plant, **options, **TUNING["ukf"]) if method == "ukf"

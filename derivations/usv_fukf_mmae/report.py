@@ -127,8 +127,9 @@ def _report(r: dict, scenario) -> str:
                "(lambda = 0: non-negative weights)"],
               ["models", ", ".join(f"{m} ({6 + len(th)} states{': alpha of ' + th[0] if th else ''})"
                                    for m, th in MODELS.items())],
-              ["Q, velocities", "(dt M^-1)^2 alpha_d^2 / 3 per sample: the disturbance's own variance"],
-              ["Q, x, y, psi", f"std {', '.join(f'{v:g}' for v in t['eta_std'])} (m, m, rad) per sample"],
+              ["Q, kinematic states", "G diag(alpha_d^2 / 3) G^T, G = d x_(k+1) / d tau_d of the RK4 step "
+                                      "(casadi.jacobian): the disturbance's own covariance through the sampled "
+                                      "model; positions isotropic (largest over headings), uncorrelated"],
               ["Q, efficiency random walk", f"std {t['alpha_walk_std']:g} per sample"],
               ["R", "the sensor noise variances of the scenario"],
               ["P0", f"std {', '.join(f'{v:g}' for v in t['P0_std'])} (x, y, psi, u, v, r, alpha)"],
