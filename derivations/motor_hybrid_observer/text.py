@@ -78,6 +78,8 @@ def report_text(r: dict, figures: list[tuple[str, str]]) -> str:
             f"{r['case_b_final_estimate_analytic']:.5f}", f"{r['corrected_case_b_final_error']:.2e}",
             f"{r['corrected_case_b_final_error_analytic']:.2e}"]]
     u = r["unknown_start_estimate"]
+    base_a = "detects" if r["baseline_detects_incipient"] else "also misses"
+    base_b = "detects" if r["baseline_detects_step"] else "misses"
     wander = ", ".join(f"{v:.4f}" for v in r["estimator_fault_free_final_other_noise"])
     ratio_a, ratio_b = (100 * r[f"case_{c}_final_estimate_ratio"] for c in ("a", "b"))
     analytic_a = 100 * r["case_a_final_estimate_analytic"] / r["case_a_true_fault_final"]
@@ -172,13 +174,12 @@ observer (T E = 0; its (T A, C) is observable through the speed) with its gain f
 {markdown_table(["residual", "threshold (rad/s)", "alarm, case a (s)", "alarm, case b (s)", "false alarm"], det)}
 
 The paper: the hybrid residual crosses its threshold in both cases, the baseline misses the
-incipient fault (and, in its Fig. 4, the step). Here the baseline
-{"also misses" if not r["baseline_detects_incipient"] else "detects"} case a, but
-{"detects" if r["baseline_detects_step"] else "misses"} case b: its gain ({BASELINE_DECAY:g} 1/s) lets the speed
-estimate follow a slow drift (the residual of a 0.8 1/s drift of 2 rad/s stays near
-1.6 / {BASELINE_DECAY:g} rad/s), while the step's jump of 2 rad/s shows at once. The hybrid detector sees
-the drift because its speed gain is slow (L1 = {L1:g} 1/s), not because of the decoupling: both
-residuals are free of the disturbance (T E = 0 in both).
+incipient fault (and, in its Fig. 4, the step). Here the baseline {base_a} case a but
+{base_b} case b: its gain ({BASELINE_DECAY:g} 1/s) lets the speed estimate follow a slow drift (the
+residual of a 0.8 1/s drift of 2 rad/s stays near 1.6 / {BASELINE_DECAY:g} rad/s), while the step's jump of
+2 rad/s shows at once. The hybrid detector sees the drift because its speed gain is slow
+(L1 = {L1:g} 1/s), not because of the decoupling: both residuals are free of the disturbance
+(T E = 0 in both).
 
 ### Fault estimates (means over the last second)
 
@@ -203,9 +204,10 @@ the noise level.
 
 ## Choices where the paper is silent
 
-Motor parameters (MSL), operating point and I0 (the plant's docstring); F = (0, 0, 2)^T (the printed
-5-vector is for the state, the outputs are three); the gains above; the rotor-resistance profile
-(+{RR_DRIFT * 100:g} % linear); {DURATION:g} s runs sampled at 0.1 ms (RK4, inputs held); the thresholds and the alarm
-rule of the motor's Luenberger study; the adaptive law driven by the measured residual r rather
-than the unmeasured e2, integrated as in the paper's remark 5.
+Motor parameters (MSL), operating point and I0 (the plant's docstring); F = (0, 0, 2)^T (the
+printed (0 0 0 0 2)^T has five entries for three outputs; F2 = 2 on the speed sensor as printed);
+the gains above; the rotor-resistance profile (+{RR_DRIFT * 100:g} % linear); {DURATION:g} s runs sampled at
+0.1 ms (RK4, inputs held); the thresholds and the alarm rule of the motor's Luenberger study; the
+adaptive law driven by the measured residual r rather than the unmeasured e2, integrated as in
+the paper's remark 5.
 """
