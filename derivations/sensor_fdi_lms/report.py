@@ -16,9 +16,11 @@ from derivations.sensor_fdi_lms.observer_sets import lms_set
 from derivations.sensor_fdi_lms.study import R0_GRID, SIZE_DEG, WITHIN, detection_study
 from derivations.sensor_fdi_lms.text import report_text
 from uvsym.errors import SimulationError
-from uvsym.observers.lms import mu_bound
+from uvsym.observers.lms import lms_step, mu_bound
 from uvsym.report import write_json
+from uvsym.report.equations import function_equations
 from uvsym.report.sections import c_package, claim_rows
+from uvsym.systems.signals import Signals
 
 __all__ = ["build", "PAPER", "SETTLED", "FTC_WINDOW"]
 
@@ -166,7 +168,17 @@ def build(out_dir: Path, progress) -> None:
                     "kp_per_rad": D.design().kp, "kp_per_deg": D.design().kp * math.pi / 180.0},
     }
     write_json(out_dir / "results.json", results)
-    (out_dir / "report.md").write_text(report_text(results, paper("zhu-lms")))
+    (out_dir / "report.md").write_text(report_text(results, paper("zhu-lms"), _rendered_step()))
+
+
+def _rendered_step(order: int = 3) -> list[str]:
+    """LaTeX lines of the bare LMS step of a small order, rendered from its CasADi graph."""
+    def named(*entries) -> Signals:
+        return Signals(tuple(entries), ("",) * len(entries))
+
+    weights, inputs = (named(*(f"{b}_{i}" for i in range(1, order + 1))) for b in ("C", "U"))
+    return function_equations(lms_step(order), [weights, inputs, named("y"), named("u"), named("mu")],
+                              [(weights, "next"), (inputs, "next"), (named("d"), ""), (named("e"), "")])
 
 
 def _classified(summary: dict) -> str:

@@ -102,8 +102,9 @@ def _steps(r: dict) -> str:
                            "max abs heading error with FTC, +30 deg (deg)"], rows)
 
 
-def report_text(r: dict, source) -> str:
-    """The report (Markdown) from the results ``r`` and the paper ``source`` (derivations.papers.Paper)."""
+def report_text(r: dict, source, step_lines: list[str]) -> str:
+    """The report (Markdown) from the results ``r``, the paper ``source`` (derivations.papers.Paper)
+    and the LaTeX lines of the bare LMS step of a small order."""
     c, learning, study = r["choices"], r["learning"], r["study"]
     negative = next(row for row in r["claims"] if row["expected"] == "refuted")
     return f"""# Sensor-fault diagnosis with an adaptive LMS-FIR filter, and fault-tolerant heading hold
@@ -149,6 +150,11 @@ C_{{k+1}} = C_k - 2 \\mu e_k U_k $$
 $$ \\varepsilon^2(k) = e_k^2 > \\varepsilon_0,\\qquad S_k = \\textstyle\\sum_i C_{{i,k}},\\quad
 R(k) = \\frac{{(S_k - \\bar S)^2}}{{\\operatorname{{var}} S}} \\text{{ over }} S_{{k-n+1}}, \\dots, S_k,\\quad R > r_0
 \\text{{ on }} h \\text{{ samples in a row}} $$
+
+The step as uvsym builds it (`uvsym.observers.lms.lms_step`), rendered from its CasADi graph for
+M = 3 (y stands for $y - r$; $^+$ marks the next sample's value):
+
+{chr(10).join(f"$$ {line} $$" for line in step_lines)}
 
 - **Sign of the update.** The paper prints $C_{{k+1}} = C_k + 2\\mu e(k) u(k)$ with $e = d - y$ (L137, L141),
   which climbs the squared error; the step here descends it.
