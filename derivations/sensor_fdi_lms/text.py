@@ -175,7 +175,7 @@ M = 3 (y stands for $y - r$; $^+$ marks the next sample's value):
 - **Thresholds** (not in the paper): $\\varepsilon_0$ = {c['eps0_deg2']:g} deg^2 (3 deg, the paper's FTC tolerance),
   $r_0$ = {c['r0']:g} (a z-score of 3).
 
-## Set-up (uvsym's choices; the paper gives none of these)
+## Set-up (the paper's fault and sample period; the rest uvsym's choices)
 
 - **Fault**: the paper's "fixed drift" fault is a constant added to the measured heading from sample
   70 on (L508-521): uvsym's sensor fault kind `bias` with a step profile.
