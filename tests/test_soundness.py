@@ -134,6 +134,9 @@ def test_identity_findings():
     assert tanh.status != "refuted" and time.perf_counter() - started < 20
     assert_checked(tanh)
     assert_proved(prove_identity("rational", (x ** 2 - 1) / (x - 1), x + 1, [x], "x != 1"))
+    # 0.1 * 3 is 0.3000000000000000166... exactly, not the double 0.30000000000000004: never "proved"
+    y = ca.SX.sym("y")
+    assert prove_identity("folded", 0.1 * (y * (3 * x)), 0.30000000000000004 * x * y, [x, y], "all").status != "proved"
 
 
 def test_assert_proved_refuses_checked_evidence():
