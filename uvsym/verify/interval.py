@@ -56,6 +56,7 @@ __all__ = ["IntervalFunction", "Intervals"]
 
 _NAMES = {getattr(ca, name): name[3:].lower() for name in dir(ca) if name.startswith("OP_")}
 
+
 def _outside_domain(op: int, args) -> np.ndarray | None:
     """(k,) True where the operation's argument may leave its domain; None for total operations."""
     a = args[0]
