@@ -103,3 +103,16 @@ def test_bad_banks_are_refused():
                                    output=lambda x, u, p: ca.vertcat(x, x)), dt=0.2, Q=1.0, R=R, P0=1.0)
     with pytest.raises(ObserverError, match="sampled every"):
         mmae_bank({"plain": plain, "slow": slow})
+
+
+def test_a_nan_measurement_leaves_the_probabilities_and_says_so():
+    rng = np.random.default_rng(5)
+    Y, U = rng.normal(size=(30, 2)), rng.normal(size=(30, 1))
+    Y[12, 0] = np.nan
+    bank = mmae_bank({"plain": extended_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, name="plain"),
+                      "biased": unscented_filter(biased_plant(), dt=0.1, Q=Q4, R=R, P0=P04, name="biased")})
+    S, OUT = run_filter(bank, Y, U)
+    names = bank.publishes.names
+    assert OUT[:, names.index("skipped")].tolist() == [float(k == 12) for k in range(30)]
+    np.testing.assert_array_equal(S[13, -2:], S[12, -2:])  # log-probabilities carried over unchanged
+    assert OUT[12, names.index("loglik_plain")] == 0.0 and np.all(np.isfinite(OUT))
