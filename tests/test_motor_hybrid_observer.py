@@ -41,6 +41,7 @@ def test_flux_modes_are_invisible_to_the_currents_whatever_K1():
 def test_estimator_steady_state_matches_the_hand_derivation():
     # e' = A e + B f', a unit step: the zero mode's projection gives 1 - L2 / (L2 + 2 Gamma M1)
     assert estimate(estimator_model(), "step", [9.0])[0] == pytest.approx(step_limit(), abs=1e-9)
+    assert estimate(estimator_model(), "incipient", [0.0, 0.5]).tolist() == [0.0, 0.0]  # before the onset
     assert 0.996 < step_limit() < 1.0
 
 

@@ -35,14 +35,17 @@ def corrected_model() -> LinearErrorModel:
 
 
 def estimate(model: LinearErrorModel, case: str, times) -> np.ndarray:
-    """f_hat at ``times`` (s) for ``case`` "step", "incipient" (unit fault from FAULT_ONSET) or
-    "initial error" (no fault; the motor's initial offset, the observer at the operating point)."""
+    """f_hat at ``times`` (s) for ``case`` "step", "incipient" (unit fault from FAULT_ONSET, 0 before)
+    or "initial error" (no fault; the motor's initial offset, the observer at the operating point)."""
     out = []
     for t in np.atleast_1d(np.asarray(times, dtype=float)):
         tau = t - FAULT_ONSET
         if case == "initial error":
             e0 = np.concatenate([INITIAL_OFFSET, np.zeros(model.A.shape[0] - INITIAL_OFFSET.size)])
             out.append(-float((model.G @ expm(model.A * t) @ e0)[0]))
+            continue
+        if tau < 0:  # before the onset: no fault, no error
+            out.append(0.0)
             continue
         if case == "step":
             fault, e = 1.0, expm(model.A * tau) @ model.B

@@ -22,6 +22,7 @@ PAPER_ESTIMATES = {"case a (incipient)": 0.996, "case b (step)": 0.997}  # rad/s
 FINAL_WINDOW = 1.0  # s: final estimates are means over the run's last second (the estimate is noisy)
 UNKNOWN_START = "fault-free, observers start at the operating point"
 STRIDE = 50  # every 50th sample (5 ms) in the figures
+ERROR_ZOOM = (-0.01, 0.01)  # rad/s: the estimation-error panels show the settled error, not the onset's jump
 
 
 def _final(run: dict, key: str) -> float:
@@ -48,24 +49,37 @@ def _estimates(runs: dict) -> dict:
     return out
 
 
+def _mean(t: np.ndarray, values: np.ndarray, window: int = 1000) -> tuple[np.ndarray, np.ndarray]:
+    """(times, centred means over ``window`` samples (0.1 s)) every STRIDE samples, where the window is
+    full: the estimates carry the sensor noise."""
+    means = np.convolve(values, np.ones(window) / window, mode="valid")
+    return t[window // 2: window // 2 + means.size][::STRIDE], means[::STRIDE]
+
+
 def _coarse(model, case: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(times, analytic estimate) every 20 ms (one matrix exponential per point)."""
     times = t[::20 * STRIDE // 5]
     return times, estimate(model, case, times)
 
 
-def _figure(path: Path, t, curves: list[tuple], ylabel: str, title: str, threshold: float | None = None) -> None:
-    fig, ax = plt.subplots(figsize=(7, 3.2))
-    for values, style, label in curves:  # values on t, or (times, values) of their own
-        times, values = values if isinstance(values, tuple) else (t[::STRIDE], values[::STRIDE])
-        ax.plot(times, values, style, lw=1, label=label)
+def _figure(path: Path, t, panels: list[tuple], title: str, threshold: float | None = None) -> None:
+    """One panel per (curves, ylabel[, y limits]); a curve is (values on t, or (times, values)), style,
+    label; the threshold (dashed, +-) goes on the first panel."""
+    fig, axes = plt.subplots(len(panels), 1, figsize=(7, 3.2 * len(panels)), sharex=True, squeeze=False)
+    for ax, (curves, ylabel, *limits) in zip(axes[:, 0], panels):
+        if limits:
+            ax.set_ylim(*limits[0])
+        for values, style, label in curves:
+            times, values = values if isinstance(values, tuple) else (t[::STRIDE], values[::STRIDE])
+            ax.plot(times, values, style, lw=1, label=label)
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=7, loc="upper right")
     if threshold is not None:
         for sign in (-1, 1):
-            ax.axhline(sign * threshold, color="grey", ls="--", lw=1, label="threshold" if sign > 0 else None)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
+            axes[0, 0].axhline(sign * threshold, color="grey", ls="--", lw=1, label="threshold" if sign > 0 else None)
+        axes[0, 0].legend(fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("time (s)")
+    axes[0, 0].set_title(title, fontsize=9)
     save_svg(fig, path)
 
 
@@ -78,23 +92,29 @@ def _figures(cases: dict, out_dir: Path) -> list[tuple[str, str]]:
         r = runs[case]
         who = "hybrid detection observer (eq. 6)" if detector == "detection" else "baseline UIO [11]"
         name = f"fig{number}_{detector}_{case.split()[1]}.svg"
-        _figure(out_dir / name, r["t"], [(free[f"{detector}_r_omega_m"], "0.7", "fault-free"),
-                                         (r[f"{detector}_r_omega_m"], "C3", case)], "r_omega_m (rad/s)",
+        _figure(out_dir / name, r["t"], [([(free[f"{detector}_r_omega_m"], "0.7", "fault-free"),
+                                           (r[f"{detector}_r_omega_m"], "C3", case)], "r_omega_m (rad/s)")],
                 f"Fig. {number}: speed residual of the {who}, {case}", thresholds[detector])
         files.append((name, f"Fig. {number}: {who}, {case}"))
     for number, case, kind in ((5, "case a (incipient)", "incipient"), (6, "case b (step)", "step")):
         r = runs[case]
         name = f"fig{number}_estimate_{case.split()[1]}.svg"
-        _figure(out_dir / name, r["t"], [(r["f_s"], "k", "fault f_s"),
-                                         (r["estimator_f_s_hat"], "C0", "hybrid estimator (eq. 18)"),
-                                         (_coarse(estimator_model(), kind, r["t"]), "C0--", "its analytic value"),
-                                         (r["corrected_f_s_hat"], "C2", "corrected design")],
-                "f_s (rad/s)", f"Fig. {number}: speed-sensor fault and its estimates, {case}")
+        times, analytic = _coarse(estimator_model(), kind, r["t"])
+        fault = np.interp(times, r["t"], r["f_s"])
+        estimates = [(r["f_s"], "k", "fault f_s"), (r["estimator_f_s_hat"], "C0", "hybrid estimator (eq. 18)"),
+                     ((times, analytic), "C0--", "its analytic value"),
+                     (r["corrected_f_s_hat"], "C2", "corrected design")]
+        errors = [(_mean(r["t"], r["f_s"] - r["estimator_f_s_hat"]), "C0", "hybrid estimator (0.1 s means)"),
+                  ((times, fault - analytic), "C0--", "its analytic value"),
+                  (_mean(r["t"], r["f_s"] - r["corrected_f_s_hat"]), "C2", "corrected design (0.1 s means)")]
+        _figure(out_dir / name, r["t"], [(estimates, "f_s (rad/s)"), (errors, "f_s - f_hat (rad/s)", ERROR_ZOOM)],
+                f"Fig. {number}: speed-sensor fault and its estimates, {case}")
         files.append((name, f"Fig. {number}: fault and estimates, {case}"))
     r = runs[UNKNOWN_START]
-    _figure(out_dir / "fig7_unknown_start.svg", r["t"], [(r["estimator_f_s_hat"], "C0", "hybrid estimator"),
-                                                          (r["corrected_f_s_hat"], "C2", "corrected design")],
-            "f_hat (rad/s)", "Fig. 7 (not in the paper): no fault, observers started at the operating point")
+    _figure(out_dir / "fig7_unknown_start.svg", r["t"], [([(r["estimator_f_s_hat"], "C0", "hybrid estimator"),
+                                                           (r["corrected_f_s_hat"], "C2", "corrected design")],
+                                                          "f_hat (rad/s)")],
+            "Fig. 7 (not in the paper): no fault, observers started at the operating point")
     files.append(("fig7_unknown_start.svg", "Fig. 7 (not in the paper): fault-free, observers start at the operating "
                                             "point"))
     return files
