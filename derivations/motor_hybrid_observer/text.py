@@ -78,6 +78,8 @@ def report_text(r: dict, figures: list[tuple[str, str]]) -> str:
             f"{r['case_b_final_estimate_analytic']:.5f}", f"{r['corrected_case_b_final_error']:.2e}",
             f"{r['corrected_case_b_final_error_analytic']:.2e}"]]
     u = r["unknown_start_estimate"]
+    paper_a, paper_b = r["paper_estimates"]["case a (incipient)"], r["paper_estimates"]["case b (step)"]
+    ratio_paper = paper_a / (1.0 - paper_a)  # 1 - L2 / (L2 + 2 Gamma M1) = paper_a
     base_a = "detects" if r["baseline_detects_incipient"] else "also misses"
     base_b = "detects" if r["baseline_detects_step"] else "misses"
     wander = ", ".join(f"{v:.4f}" for v in r["estimator_fault_free_final_other_noise"])
@@ -127,11 +129,11 @@ In words:
    along E's range (A12 = n_p Lr (-lambda_rd E_3 + lambda_rq E_4)), so Tu A12 = 0 (here
    {r["Tu_A12_relative"]:.1e} relative). The estimator's linearised error matrix keeps a zero
    eigenvalue whatever the gains: {_eigs(r["estimator_error_eigenvalues"])} 1/s.
-4. **What 0.996 is.** With that zero mode the estimate does not converge to the fault; it settles
+4. **What {paper_a:g} is.** With that zero mode the estimate does not converge to the fault; it settles
    where the mode's projection puts it. For a step, f_hat -> 1 - L2 / (L2 + 2 Gamma M1) =
    {r["step_estimate_limit_closed_form"]:.6f} with this study's L2 = {L2:g}, Gamma = {gamma:g}, M1 = {m1:g}: the paper's
-   0.996 / 0.997 are such a bias, set by the gain ratio (2 Gamma M1 / L2 = 249 gives 0.996), not a
-   convergence. The same zero mode turns an initial speed error into a fault estimate (Fig. 7):
+   {paper_a:g} / {paper_b:g} are such a bias, set by the gain ratio (2 Gamma M1 / L2 = {ratio_paper:.0f} gives
+   {paper_a:g}), not a convergence. The same zero mode turns an initial speed error into a fault estimate (Fig. 7):
    with the observers started at the operating point (the motor {INITIAL_OFFSET[4]:g} rad/s away), the
    fault-free estimate settles at {u["estimator"]:.4f} rad/s (analytic {u["estimator_analytic"]:.4f}).
 
