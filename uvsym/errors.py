@@ -136,7 +136,3 @@ class UIOConditionError(ObserverError):
 
 class PrecisionError(CodegenError):
     """A single-precision C build strays too far from double precision on its example data (names the figure)."""
-
-
-class StepSizeWarning(UserWarning):
-    """An adaptive filter's step size is at or beyond its stability bound (the message gives the bound)."""

@@ -4,7 +4,7 @@ A fault changes a healthy value ``v`` (an actuator's applied value, or a measure
 
     v_f = v + phi(t) * (target(v) - v)
 
-where ``phi(t)`` in [0, 1] is the fault's time profile and ``target`` its kind (core paper,
+where ``phi(t)`` in [0, 1] is the fault's time profile and ``target`` its kind (Liu et al. 2014,
 Definition 1, for actuators). Everything is a CasADi expression of ``t``, so integrators, the
 fixed-step path and generated code all see the same fault; ``phi`` is exactly 0 before onset.
 
@@ -219,7 +219,7 @@ class Profile:
 class ActuatorFault:
     """A fault on one actuator (index into the model's inputs), ``value`` in the kind's unit.
 
-    kind: a name in ACTUATOR_KINDS -- proportional ``value * v`` (core paper f_p); bias
+    kind: a name in ACTUATOR_KINDS -- proportional ``value * v`` (Liu et al. 2014's f_p); bias
     ``v + value`` (f_a); constant ``value`` regardless of the command (f_c, stuck);
     loss_of_effectiveness ``(1 - value) * v``, value in [0, 1].
     """

@@ -1,6 +1,6 @@
 """The induction motor's Luenberger observer: plant, operating point, LMI gain (uvsym's choices).
 
-The plant is uvsym's ``induction_motor`` (Yu, Jiang & Zhang 2018, eq. 23; MSL parameters). The
+The plant is uvsym's ``induction_motor`` (Yu et al. 2018, eq. 23; MSL parameters). The
 gain L makes ``A - L C`` at the operating point decay at ``DECAY`` 1/s; it comes from the LMI
 ``A^T P + P A - C^T Y^T - Y C + 2 DECAY P < 0``, ``L = P^-1 Y``
 (:func:`uvsym.verify.synthesize_observer_gain`). The observer runs at ``DT`` (a 10 kHz drive

@@ -4,7 +4,7 @@ The motor runs at its operating point on constant supply voltages (an open-loop 
 perturbed initial state; the observer starts at the operating point, reads the three measured
 outputs (with noise) and the voltages, and publishes its estimates and residuals. The speed
 sensor then reads ``omega_m + F f(t)`` with ``F = 2`` and ``f`` a unit step or
-``1 - exp(-0.8 (t - 1))`` from t = 1 s (the incipient sensor-fault paper's two cases). The
+``1 - exp(-0.8 (t - 1))`` from t = 1 s (the two cases of Yu et al. 2018). The
 detection threshold on ``|r_omega_m|`` is 1.2 times its largest value in three fault-free runs
 with other noise than the runs it judges, after the observer has converged; an alarm needs
 ``CONFIRM`` samples in a row above it (uvsym's choices). Runs on CasADi's virtual machine so the

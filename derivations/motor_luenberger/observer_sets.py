@@ -1,7 +1,7 @@
 """``uvsym codegen motor-luenberger``: the motor observer's step as a C package.
 
 The observer is uvsym's Luenberger design (:mod:`.design`) on the induction-motor model; it does
-not implement the incipient-fault paper's unknown-input observer, so the package cites no paper.
+not implement Yu et al. 2018's unknown-input observer, so the package cites no paper.
 Its example (``main.c``, the float check of ``--float``) is ``EXAMPLE_STEPS`` steps of the
 fault-free experiment run (:func:`.experiment.run`) from ``EXAMPLE_START``: the observer's state,
 the noisy measurements and the supply voltages.

@@ -22,6 +22,7 @@ from derivations.motor_luenberger.experiment import (
     run_cases,
 )
 from derivations.motor_luenberger.observer_sets import motor_luenberger
+from derivations.papers import paper
 from uvsym.report import latex_matrix, markdown_table, save_svg, write_json
 from uvsym.report.equations import observer_equations
 from uvsym.report.sections import c_package, c_section, claim_rows, claims_table, counterexamples
@@ -29,6 +30,7 @@ from uvsym.report.sections import c_package, c_section, claim_rows, claims_table
 __all__ = ["build"]
 
 OBSERVER = "luenberger"
+YU = paper("yu2018")
 
 
 def _estimation_errors(result) -> list[dict]:
@@ -100,8 +102,8 @@ def _report(r: dict) -> str:
     slowest = abs(max(re for re, _ in modes))  # 1/s, the speed channel's rate
     return f"""# A Luenberger observer of the induction motor, through every stage
 
-Every stage of uvsym on a plant that is not a vehicle: the d-q induction motor of the incipient
-sensor-fault paper (Yu, Jiang & Zhang 2018, eq. 23), `uvsym.plant("induction_motor")`, with
+Every stage of uvsym on a plant that is not a vehicle: the d-q induction motor of
+{YU.short}'s incipient sensor-fault study (eq. 23; {YU.reference()}), `uvsym.plant("induction_motor")`, with
 Modelica Standard Library parameters. A Luenberger observer (`uvsym.observers.luenberger`)
 with a gain from an LMI, simulated in a loop wired by signal name with a speed-sensor fault,
 exported as C and compared with Python, its error dynamics checked by `uvsym verify`. Every
@@ -149,8 +151,8 @@ threshold. The incipient fault is not detected: its steepest slope,
 {SENSOR_GAIN * INCIPIENT_RATE:g} rad/s^2, leaves a tracking residual of about
 {SENSOR_GAIN * INCIPIENT_RATE / slowest:.2g} rad/s, below the threshold; an alarm needs {CONFIRM} samples in a row above
 it, so a noise excursion of a sample or two is not one. Holding the alarm, or estimating the
-fault itself, is what the incipient sensor-fault paper's unknown-input and adaptive observers
-add (a later study).
+fault itself, is what Yu et al. 2018's unknown-input and adaptive observers
+add (`reports/motor-hybrid-observer/`).
 
 Estimation error (RMS of $x - \\hat x$, fault-free, {CONVERGED_AFTER:g} s to {FAULT_ONSET:g} s):
 

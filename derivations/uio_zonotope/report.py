@@ -7,6 +7,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from derivations.papers import paper
 from derivations.uio_zonotope.claims import enclosure_claim, uio_claims
 from derivations.uio_zonotope.design import (
     ATTITUDE,
@@ -37,6 +38,7 @@ from uvsym.report.sections import claim_rows, claims_table
 __all__ = ["build"]
 
 FIGURE_SEED = 0
+YANG = paper("yang-uio")
 
 
 def _figure(fault: Fault, title: str, path: Path) -> dict:
@@ -154,8 +156,10 @@ def _report(r: dict) -> str:
                "C v = 0 checked in rationals" for c in r["refutations"]]
     return f"""# Unknown-input observer bank with zonotope thresholds on a quadrotor
 
-Reproduction of Yang, Hu & Zhang (quadrotor actuator faults: a bank of discrete unknown-input
-observers, one per actuator, with thresholds from zonotopes). The paper's matrices, bounds,
+Reproduction of {YANG.short}: {YANG.reference()}
+
+The paper: quadrotor actuator faults, a bank of discrete unknown-input observers, one per
+actuator, with thresholds from zonotopes. The paper's matrices, bounds,
 poles, fault sizes and run length are lost from the text; every number below is uvsym's choice,
 stated, and computed by the run that wrote this report.
 

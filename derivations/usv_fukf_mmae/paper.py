@@ -1,4 +1,4 @@
-"""What the FUKF-MMAE paper prints, checked by machine: its eq. 4 against the model of its eqs. 1-3,
+"""What Li et al. 2025 (the FUKF-MMAE paper) prints, checked by machine: its eq. 4 against the model of its eqs. 1-3,
 its eq. 11's weights, its eq. 18's shapes."""
 
 from __future__ import annotations
@@ -6,13 +6,12 @@ from __future__ import annotations
 import numpy as np
 
 import uvsym
+from derivations.papers import paper
 from uvsym.observers.ukf import unscented_weights
 
 __all__ = ["CITATION", "printed_eq4", "eq4_check", "eq11_check", "eq18_check"]
 
-CITATION = ("Li C., Xiao C., Li H., Liu J., Li Q., Zhou C.: Fault diagnosis method for unmanned boat propulsion "
-            "based on FUKF-MMAE. Ship Science and Technology 47(21), 73-80, 2025. "
-            "DOI 10.3404/j.issn.1672-7649.2025.21.013")
+CITATION = paper("li2025").reference()
 POINT = {"nu": (1.5, 0.3, 0.2), "u": (60.0, 40.0)}  # m/s, m/s, rad/s; N, N: where eq. 4 is compared
 
 

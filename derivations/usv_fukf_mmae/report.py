@@ -152,8 +152,10 @@ def _report(r: dict, scenario) -> str:
     figures = "\n\n".join(f"![{text}]({name})\n\n*{text}.*" for name, text in FIGURES.items())
     return f"""# Thruster faults of the Otter USV: federated UKF and EKF banks with MMAE
 
-Reproduction of {CITATION} (the FUKF-MMAE paper) with uvsym's generic filters: the UKF and EKF
-of any System (`uvsym.observers.ukf`, `uvsym.observers.ekf`), the state augmented by an actuator
+Reproduction of Li et al. 2025 (the FUKF-MMAE paper): {CITATION}
+
+It runs with uvsym's generic filters: the UKF and EKF of any System (`uvsym.observers.ukf`,
+`uvsym.observers.ekf`), the state augmented by an actuator
 efficiency (`uvsym.observers.kalman.efficiency_augmented`), and the multiple-model bank with
 log-space Bayesian probabilities, a floor, federated fusion and reset (`uvsym.observers.mmae`),
 each bank one CasADi Function per sample. Every number below is computed by the run that wrote

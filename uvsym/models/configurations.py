@@ -1,4 +1,4 @@
-"""Actuator configurations built from geometry, and their identifiability (seeds/000, sec. 2.3).
+"""Actuator configurations built from geometry, and their identifiability (Liu et al. 2014, sec. 2.3).
 
 ``tau = B u`` with B (6 x m). Two of the paper's three classes are built here from geometry;
 the first (thruster plus fins) comes from a vehicle model as ``B = d tau / d u``.

@@ -1,4 +1,4 @@
-"""Actuator-fault observers of the core paper (seeds/000, Theorems 1-3, eqs. 2-17).
+"""Actuator-fault observers of Liu et al. 2014 (Theorems 1-3, eqs. 2-17).
 
 For a vehicle ``M nu' + h(eta, nu) = tau`` with desired action ``tau_d`` the three fault types
 (Definition 1) deliver

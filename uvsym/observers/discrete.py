@@ -132,7 +132,7 @@ def gain_units(kind: str, form: str, force_units: tuple[str, ...]) -> tuple[str,
 
 def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "paper",
                             name: str | None = None) -> Observer:
-    """The core paper's ``kind`` observer (Theorems 1-3) on ``model`` as an :class:`Observer`.
+    """Liu et al. 2014's ``kind`` observer (Theorems 1-3) on ``model`` as an :class:`Observer`.
 
     step(s, y = [eta; nu], u = tau_d, p = K) -> (s_next, f_hat): the sampled-data form of this
     module. Reads the model's states by name and ``tau_d.<force>`` (the desired generalised force,

@@ -1,4 +1,4 @@
-"""Fault-tolerant correction of the commands, not the controller (seeds/000, sec. 3).
+"""Fault-tolerant correction of the commands, not the controller (Liu et al. 2014, sec. 3).
 
 For identified faults the corrected command undoes each fault's kind (its
 :meth:`~uvsym.faults.ActuatorKind.correction`): ``u*_i = u_d,i / f_p,i`` (proportional),

@@ -1,6 +1,6 @@
 """Observer gain design for a requested convergence time constant, and Remark 2's observability.
 
-The error of the core paper's observers obeys ``e' = A e`` with (diagonal M)
+The error of Liu et al. 2014's observers obeys ``e' = A e`` with (diagonal M)
 ``A = -K (M^-1 T_d)^2`` (proportional: rate ``k_i tau_d,i^2 / m_i^2``) or ``A = -K M^-2``
 (bias, constant: rate ``k_i / m_i^2``). Useful gains therefore scale with ``m_i^2``; the paper
 does not say so. In the momentum form ``A = -K T_d^2`` or ``-K`` for any M, and the design is

@@ -1,4 +1,4 @@
-"""Fault identification: actuator values from generalised forces, and severity (seeds/000, sec. 2.3).
+"""Fault identification: actuator values from generalised forces, and severity (Liu et al. 2014, sec. 2.3).
 
 Near the values ``u_e`` the actuators are expected to deliver, ``tau = tau(u_e) + B (u - u_e)``
 with ``B = d tau / d u`` at (state, u_e) -- exact for actuation affine in u (fins), first order

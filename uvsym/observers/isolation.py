@@ -1,4 +1,4 @@
-"""Fault isolation by predicted converged values and their variance (seeds/000, sec. 2.2, eqs. 18-24).
+"""Fault isolation by predicted converged values and their variance (Liu et al. 2014, sec. 2.2, eqs. 18-24).
 
 A matched observer's error obeys ``e' = A e`` (A known from tau_d), so the fault is
 ``f = f_hat - A^-1 f_hat'`` at any instant (eq. 21) -- before the estimate has converged. The

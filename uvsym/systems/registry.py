@@ -1,7 +1,7 @@
 """The plant library: plants beyond the marine vehicles, and every marine vehicle as a System.
 
 ``plant(name)`` builds (and caches) a plant of :data:`PLANTS` or, for a vehicle name,
-``uvsym.vehicle(name).as_system()`` (``plant("otter3dof")`` is the USV fault-diagnosis paper's
+``uvsym.vehicle(name).as_system()`` (``plant("otter3dof")`` is Li et al. 2025's
 Otter). The vehicle library is imported when first needed: it builds on this package.
 """
 

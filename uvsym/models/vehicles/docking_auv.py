@@ -1,4 +1,4 @@
-"""Docking AUV of the core paper (seeds/000, type 1): thrust X, elevator, split rudders, 6 DOF.
+"""Docking AUV of Liu et al. 2014 (type 1): thrust X, elevator, split rudders, 6 DOF.
 
 The REMUS 100 hull with the cruciform stern fins of the torpedo. Inputs
 u = (X thrust N, delta_e elevator rad, delta_ru upper rudder rad, delta_rd lower rudder rad):
@@ -21,7 +21,7 @@ from uvsym.models.vehicles.cruciform_fins import FINS_FILE, stern_fins
 from uvsym.models.vehicles.remus100_hull import HULL_FILE, hull
 
 NAME = "docking_auv"
-DESCRIPTION = "Docking AUV of the core paper: REMUS 100 hull, thrust X, elevator, upper and lower rudders"
+DESCRIPTION = "Docking AUV of Liu et al. 2014: REMUS 100 hull, thrust X, elevator, upper and lower rudders"
 PARAMETER_FILES = [HULL_FILE, FINS_FILE, Path(__file__).with_name("docking_auv.toml")]
 
 

@@ -1,4 +1,4 @@
-"""Otter USV in surge, sway and yaw: the 3-DOF model of the USV fault-diagnosis paper (seeds/003).
+"""Otter USV in surge, sway and yaw: the 3-DOF model of Li et al. 2025.
 
 ``M nu_dot + C(nu) nu + D nu = tau`` with ``M = diag(m11, m22, m33)``, ``D = diag(d11, d22, d33)``,
 ``C = [[0, 0, -m22 v], [0, 0, m11 u], [m22 v, -m11 u, 0]]`` and twin thrusters

@@ -1,6 +1,6 @@
 """Induction (traction) motor in the synchronous d-q frame, as printed by Yu, Jiang & Zhang (2018).
 
-``x' = A x + F_a(x) + B u + E d``, ``y = C x`` (the incipient sensor-fault paper's eq. 23 without
+``x' = A x + F_a(x) + B u + E d``, ``y = C x`` (Yu et al. 2018, eq. 23, without
 the sensor fault), x = (i_sq, i_sd, lambda_rq, lambda_rd, omega_m), u = (u_sq, u_sd), y = (i_sq,
 i_sd, omega_m)::
 
