@@ -1,16 +1,19 @@
 """The incipient sensor-fault paper's hybrid observer on the induction motor (derivation
 motor-hybrid-observer): claims, the findings behind them checked independently, short runs."""
 
+import casadi as ca
 import numpy as np
 import pytest
+from scipy.linalg import expm
 
 import uvsym
 from derivations.motor_hybrid_observer.analysis import estimate, estimator_model, step_limit
 from derivations.motor_hybrid_observer.claims import hybrid_claims
-from derivations.motor_hybrid_observer.design import design
+from derivations.motor_hybrid_observer.design import ESTIMATOR, L1, L2, design
 from derivations.motor_hybrid_observer.experiment import CASES, detection_time, run
 from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from uvsym.errors import ModelError, VerificationError
+from uvsym.observers.hybrid import linear_error_model, observer_state
 from uvsym.report.sections import c_package
 
 
@@ -80,3 +83,21 @@ def test_the_four_observers_export_to_C_that_matches_python(tmp_path):
     assert c["functions"] == [f"uvsym_motor_hybrid_{n}_step" for n in ("detection", "estimator", "baseline",
                                                                        "corrected")]
     assert c["compiled"] and "-Werror" in c["flags"] and c["max_relative_difference"] <= 1e-12
+
+
+@pytest.mark.parametrize("name", ["detection", "estimator"])
+def test_the_observer_as_run_has_the_error_matrix_of_the_analysis(name):
+    # oracle: scipy's expm of the hand-assembled error matrix against CasADi's Jacobian of the sampled
+    # step (RK4: equal to the matrix exponential up to (|A| dt)^5 / 120); e = -D (s - s*) with
+    # D = blkdiag(I, I, Gamma M1) for the state s = (v, zhat2, integral of r)
+    d = design()
+    obs = d.observers[name]
+    n_int = obs.state.size - 5
+    model = linear_error_model(d.split, d.K1, [[L1 if name == "detection" else L2]],
+                               ESTIMATOR if n_int else None)
+    s = ca.SX.sym("s", obs.state.size)
+    jacobian = ca.Function("J", [s], [ca.jacobian(obs.step(s, d.lin.y0, d.lin.u0, obs.p0)[0], s)])
+    s_star = observer_state(d.split, d.plant.x_op, d.lin.C, n_int)
+    D = np.diag([1.0] * 5 + [float((ESTIMATOR.Gamma @ ESTIMATOR.M1)[0, 0])] * n_int)
+    expected = expm(np.linalg.solve(D, model.A @ D) * obs.dt)
+    assert np.allclose(np.asarray(jacobian(s_star)), expected, rtol=0, atol=1e-6)

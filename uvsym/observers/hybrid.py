@@ -273,6 +273,7 @@ def linear_error_model(dec: Decoupling, K1, L, estimator: FaultEstimator | None 
     K1, L = _gain(K1, (n1, p1), "K1", "error model"), _gain(L, (n2, p2), "L", "error model")
     GM1, GM2, N = _estimator(estimator, dec, "error model")
     q = GM1.shape[0] if estimator is not None else 0
+    GM1, GM2 = GM1[:q], GM2[:q]  # no estimator: no fault rows
     O1, O2, O3, O4 = (dec.omega[k] for k in ("Omega1", "Omega2", "Omega3", "Omega4"))
     r_e2, r_eq = N @ dec.C4, N @ dec.F2[:, :q]  # r = N (C4 e2 + F2 e_q)
     A = np.block([[O1 - K1 @ dec.C1, O2, np.zeros((n1, q))],
