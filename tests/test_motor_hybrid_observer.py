@@ -85,7 +85,7 @@ def test_the_four_observers_export_to_C_that_matches_python(tmp_path):
     assert c["compiled"] and "-Werror" in c["flags"] and c["max_relative_difference"] <= 1e-12
 
 
-@pytest.mark.parametrize("name", ["detection", "estimator"])
+@pytest.mark.parametrize("name", ["detection", "estimator", "baseline"])
 def test_the_observer_as_run_has_the_error_matrix_of_the_analysis(name):
     # oracle: scipy's expm of the hand-assembled error matrix against CasADi's Jacobian of the sampled
     # step (RK4: equal to the matrix exponential up to (|A| dt)^5 / 120); e = -D (s - s*) with
@@ -93,11 +93,14 @@ def test_the_observer_as_run_has_the_error_matrix_of_the_analysis(name):
     d = design()
     obs = d.observers[name]
     n_int = obs.state.size - 5
-    model = linear_error_model(d.split, d.K1, [[L1 if name == "detection" else L2]],
-                               ESTIMATOR if n_int else None)
+    if name == "baseline":  # the full-order UIO: one block, e = T x - v
+        dec, model = d.full, linear_error_model(d.full, d.baseline.K[0], np.zeros((0, 0)))
+    else:
+        dec, model = d.split, linear_error_model(d.split, d.K1, [[L1 if name == "detection" else L2]],
+                                                 ESTIMATOR if n_int else None)
     s = ca.SX.sym("s", obs.state.size)
     jacobian = ca.Function("J", [s], [ca.jacobian(obs.step(s, d.lin.y0, d.lin.u0, obs.p0)[0], s)])
-    s_star = observer_state(d.split, d.plant.x_op, d.lin.C, n_int)
+    s_star = observer_state(dec, d.plant.x_op, d.lin.C, n_int)
     D = np.diag([1.0] * 5 + [float((ESTIMATOR.Gamma @ ESTIMATOR.M1)[0, 0])] * n_int)
     expected = expm(np.linalg.solve(D, model.A @ D) * obs.dt)
     assert np.allclose(np.asarray(jacobian(s_star)), expected, rtol=0, atol=1e-6)
