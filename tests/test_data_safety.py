@@ -96,3 +96,18 @@ def test_folders_that_cannot_be_made_are_typed_errors_before_any_work(tmp_path, 
         captured = capsys.readouterr()
         assert f"cannot make the folder {tmp_path}" in captured.err and f"for {what}: Permission denied" in captured.err
         assert "final state" not in captured.out  # refused before the run
+
+
+def test_quick_look_figures_make_their_folder_and_type_their_errors(tmp_path):
+    import numpy as np
+
+    from uvsym.sim.result import Signal, SimResult
+
+    result = SimResult(np.array([0.0, 1.0]), {"x": Signal(np.array([[0.0], [1.0]]), ("a",), ("m",))})
+    result.plot(tmp_path / "new" / "run.png")
+    assert (tmp_path / "new" / "run.png").read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(PathError, match=r"run.xyz"):
+        result.plot(tmp_path / "run.xyz")
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(PathError, match="afile is a file, not a folder"):
+        result.plot(tmp_path / "afile" / "run.svg")

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.io
 
 from uvsym.errors import FileFormatError, PathError, SimulationError, UnknownNameError
-from uvsym.paths import output_file
+from uvsym.paths import make_folder, output_file
 
 __all__ = ["Signal", "SimResult", "FORMATS"]
 
@@ -136,7 +136,8 @@ class SimResult:
             raise FileFormatError(f"{path} is not a result file uvsym wrote ({type(exc).__name__}: {exc})") from None
 
     def plot(self, path=None, names: tuple[str, ...] | None = None):
-        """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``.
+        """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``
+        (its folder made if missing; PathError when it cannot be written).
 
         Default signals: states, commands and fault estimates of a scenario run; states, inputs
         and every block's published signals of a wired loop."""
@@ -171,11 +172,17 @@ class SimResult:
             from uvsym.report.figures import save_svg
 
             path = Path(path)
-            if path.suffix == ".svg":
-                save_svg(fig, path)
-            else:
-                fig.savefig(path, dpi=110)
-                plt.close(fig)
+            make_folder(path.parent, "the figure")
+            try:
+                if path.suffix == ".svg":
+                    save_svg(fig, path)
+                else:
+                    fig.savefig(path, dpi=110)
+                    plt.close(fig)
+            except OSError as exc:
+                raise PathError(f"cannot write the figure to {path}: {exc.strerror or exc}") from None
+            except ValueError as exc:  # matplotlib: a format it does not know
+                raise PathError(f"cannot write the figure to {path}: {exc}") from None
         return fig
 
 
