@@ -70,6 +70,8 @@ def test_simulate_checks_its_output_before_the_run(tmp_path, capsys):
     assert main(["simulate", "docking_faults", "--out", str(existing)]) == 2
     assert "run.csv exists; refusing to overwrite" in capsys.readouterr().err
     assert existing.read_text() == "mine"
+    assert main(["simulate", "docking_faults", "--out", str(existing), "--force"]) == 0
+    assert not existing.read_text().startswith("mine")  # overwritten with the run: asked for
     afile = tmp_path / "afile"
     afile.write_text("x")
     assert main(["simulate", "docking_faults", "--out", str(afile / "run.npz")]) == 2
