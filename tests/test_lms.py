@@ -5,6 +5,7 @@ from __future__ import annotations
 import warnings
 from fractions import Fraction
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -13,7 +14,7 @@ from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
 from uvsym.errors import ObserverError, StepSizeWarning, VerificationError
 from uvsym.observers.lms import check_mu, lms_monitor, mu_bound
-from uvsym.observers.lms_supervisor import SubstitutionSupervisor, double_criterion
+from uvsym.observers.lms_supervisor import SubstitutionSupervisor, double_criterion, switch_flag
 from uvsym.systems.signals import signals
 from uvsym.verify.lms import lms_step_claim
 
@@ -215,6 +216,38 @@ def test_supervisor_on_alarm_switches_in_at_the_freeze_and_back_at_the_release()
     assert decisions[0] is None and decisions[1].channels == frozenset({"y"})
     assert decisions[2] is None and decisions[3].channels == frozenset() and decisions[4] is None
     assert supervisor.first("no R alarm").sample == 3
+
+
+def test_published_signals_do_not_depend_on_the_input_of_the_same_sample():
+    # what lets a loop switch to the substitute within the sample: out_k needs y_k and r_k, never u_k
+    obs = monitor(M=3, reference=REF)
+    f = obs.step.raw
+    s, y, u, p = (ca.SX.sym(n, f.numel_in(i)) for i, n in enumerate(("s", "y", "u", "p")))
+    out = f(s, y, u, p)[1]
+    names = obs.publishes.names
+    on_u = ca.jacobian_sparsity(out, u[0]).get_triplet()[0]
+    on_y = {names[row] for row in ca.jacobian_sparsity(out, y).get_triplet()[0]}
+    assert on_u == [] and ca.jacobian_sparsity(f(s, y, u, p)[0], u[0]).nnz() == 1  # u_k: into U_next only
+    assert {"y_sub", "fault_y", "frozen_y", "e_y", "eps2_y"} <= on_y
+
+
+def test_switch_flag_names_the_monitor_flag_of_each_rule_and_a_logging_supervisor_takes_any_chunk():
+    obs = monitor(M=2)
+    assert (switch_flag("y"), switch_flag("y", "alarm")) == ("fault_y", "frozen_y")
+    assert {switch_flag("y", rule) for rule in ("fault", "alarm")} <= set(obs.publishes.names)
+    with pytest.raises(ObserverError, match="substitute_on must be one of fault, alarm, got 'never'"):
+        switch_flag("y", "never")
+    names = obs.publishes.names
+    flags = np.zeros((8, len(names)))
+    flags[1:4, names.index("frozen_y")] = 1
+    flags[4, names.index("disturbance_y")] = 1
+    flags[6:, names.index("frozen_y")] = flags[7:, names.index("fault_y")] = 1
+    whole, by_sample = SubstitutionSupervisor(obs, correct=False), SubstitutionSupervisor(obs, correct=False)
+    assert whole.update(np.arange(8) * 0.1, {obs.name: flags}) is None
+    for i in range(8):
+        assert by_sample.update(np.array([0.1 * i]), {obs.name: flags[i:i + 1]}) is None
+    assert [(e.sample, e.what[:5]) for e in whole.events] == [(1, "eps2 "), (4, "no R "), (6, "eps2 "), (7, "R ala")]
+    assert whole.events == by_sample.events
 
 
 @pytest.mark.skipif(find_compiler() is None, reason="no C compiler")

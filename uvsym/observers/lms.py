@@ -31,6 +31,9 @@ On the first ``eps2`` alarm the weights are stored; the double criterion
 live prediction ``<y>_fir = r + d``, the substitute ``<y>_sub`` (the frozen filter's ``r + C_f .
 U_k`` while frozen, else the live prediction), ``e_<y>``, ``eps2_<y>``, ``R_<y>`` and the flags
 ``alarm_eps2_<y>``, ``alarm_R_<y>``, ``frozen_<y>``, ``fault_<y>``, ``disturbance_<y>`` (0/1).
+None of them depends on the input u_k it reads (u_k only enters the next regression vector), so a
+loop may switch a controller to ``<y>_sub`` by ``fault_<y>`` within the same sample
+(:func:`uvsym.sim.blocks.select`) without an algebraic loop.
 
 Mean-square stability (independence theory, Widrow & Stearns 1985): with input power
 ``P_u = E[u^2]`` the trace of the regression covariance is ``M P_u`` and the update above is

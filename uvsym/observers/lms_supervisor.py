@@ -17,9 +17,15 @@ carried from the last sample::
 
 ``confirm`` (samples) is how long ``R`` has to confirm an ``eps^2`` alarm; after a release the
 next ``eps^2`` alarm freezes the filter anew. :func:`double_criterion` is that logic as a
-casadi.Function (used inside the LMS observer's step, so it runs compiled and in C);
-:class:`SubstitutionSupervisor` turns the published fault flag into a measurement
-substitution (:class:`uvsym.sim.run.Substitution`) and keeps the event log.
+casadi.Function (used inside the LMS observer's step, so it runs compiled and in C).
+
+Two ways to put the substitute in the loop. In the same sample: a switch block
+(:func:`uvsym.sim.blocks.select`) on the flag :func:`switch_flag` names publishes ``flag ? <y>_sub
+: <y>`` for the controller to read; the flag of sample k is computed from y_k, the substitute from
+data up to k - 1, so the controller acts on the substitute from the sample the flag rises.
+From the next sample: :class:`SubstitutionSupervisor` turns the published flag into a measurement
+substitution (:class:`uvsym.sim.run.Substitution`), one sample late. Both keep the event log of
+:class:`SubstitutionSupervisor` (with ``correct=False`` it only logs).
 """
 
 from __future__ import annotations
@@ -31,9 +37,20 @@ import numpy as np
 
 from uvsym.errors import ObserverError
 
-__all__ = ["DECISION_STATE", "double_criterion", "Event", "SubstitutionSupervisor"]
+__all__ = ["DECISION_STATE", "SWITCH_FLAGS", "double_criterion", "switch_flag", "Event", "SubstitutionSupervisor"]
 
 DECISION_STATE = ("frozen", "age", "fault")
+SWITCH_FLAGS = {"fault": "fault", "alarm": "frozen"}  # substitute_on -> the flag that switches the sensor out
+
+
+def switch_flag(channel: str, substitute_on: str = "fault") -> str:
+    """The monitor's published flag (0/1) that is set while ``channel`` is replaced by its substitute:
+    ``fault_<y>`` once the fault is confirmed (``"fault"``), ``frozen_<y>`` from the first eps^2
+    alarm to the release (``"alarm"``; a confirmed fault keeps the filter frozen).
+    ObserverError naming substitute_on for another rule."""
+    if substitute_on not in SWITCH_FLAGS:
+        raise ObserverError(f"substitute_on must be one of {', '.join(SWITCH_FLAGS)}, got {substitute_on!r}")
+    return f"{SWITCH_FLAGS[substitute_on]}_{channel}"
 
 
 def double_criterion(confirm: int) -> ca.Function:
@@ -76,17 +93,20 @@ class SubstitutionSupervisor:
     ``Substitution({y})``: from the next sample on the loop reads the monitor's substitute
     ``<y>_sub`` instead of the sensor (wire ``substitutions={y: f"{y}_sub"}``). With
     ``substitute_on="alarm"`` (the paper's Sec. 4.3) it substitutes from the first ``eps^2``
-    alarm and switches back when the freeze is released unconfirmed. ``correct=False`` logs
-    without substituting (the run without fault-tolerant control). ``events``: the log.
+    alarm and switches back when the freeze is released unconfirmed (:func:`switch_flag`).
+    ``correct=False`` logs without substituting (the run without fault-tolerant control, or a
+    loop that switches in the same sample); ``update`` then takes a chunk of any length, so the
+    log can be built after the run. ``events``: the log.
     """
 
-    MODES = ("fault", "alarm")
+    MODES = tuple(SWITCH_FLAGS)
 
     def __init__(self, monitor, *, correct: bool = True, substitute_on: str = "fault"):
-        if substitute_on not in self.MODES:
-            raise ObserverError(f"supervisor: substitute_on must be one of {', '.join(self.MODES)}, got "
-                                f"{substitute_on!r}")
         channel = monitor.reads_y.names[0]
+        try:
+            switch_flag(channel, substitute_on)
+        except ObserverError as exc:
+            raise ObserverError(f"supervisor: {exc}") from None
         names = monitor.publishes.names
         try:
             self._columns = [names.index(f"{flag}_{channel}") for flag in ("frozen", "fault", "disturbance")]
@@ -113,7 +133,7 @@ class SubstitutionSupervisor:
                 self.events.append(Event(float(ti), k, "no R alarm in time: disturbance, filter released"))
             self._frozen, self._fault = frozen[i], fault[i]
         self._samples += len(t)
-        wanted = self._fault > 0.5 or (self.substitute_on == "alarm" and self._frozen > 0.5)
+        wanted = (self._fault if SWITCH_FLAGS[self.substitute_on] == "fault" else self._frozen) > 0.5
         if not self.correct or wanted == self._switched:
             return None
         self._switched = wanted

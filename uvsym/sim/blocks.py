@@ -22,7 +22,7 @@ from uvsym.errors import WiringError
 from uvsym.observers.base import Observer, check_name
 from uvsym.systems.signals import Signals
 
-__all__ = ["Block", "block", "observer_block", "renamed", "as_signals"]
+__all__ = ["Block", "block", "observer_block", "renamed", "as_signals", "select"]
 
 STEP_INPUTS = ("s", "r")
 STEP_OUTPUTS = ("s_next", "out")
@@ -135,3 +135,35 @@ def observer_block(obs: Observer, p=None, *, s0=None) -> Block:
     return block(obs.name, step=lambda s, r: obs.step(s, r[:n_y], r[n_y:], ca.DM(p)), state=obs.state,
                  reads=obs.reads_y + obs.reads_u, publishes=obs.publishes, s0=s0, dt=obs.dt, init=init,
                  description=obs.description)
+
+
+def select(name: str, *, flag: str, on: str | Sequence[str], off: str | Sequence[str], output: str | Sequence[str],
+           unit: str = "") -> Block:
+    """A switch of the same sample: ``output_k = on_k if flag_k > 0.5 else off_k``, no state.
+
+    flag: one loop signal (0/1, e.g. an observer's fault flag); on, off, output: n loop signal
+    names each (n >= 1, entry i of output is entry i of on or off); unit: of on, off and output
+    (the wiring then refuses an on or off in another unit), or "" to take it from the loop. The
+    output feeds its reads through within the sample, so the wiring evaluates it after the flag
+    and both branches; a flag that depends on the output is an algebraic loop (WiringError).
+    WiringError naming the argument for sizes that differ, no names, or a name used twice.
+    """
+    groups = {"on": on, "off": off, "output": output}
+    names = {what: (spec,) if isinstance(spec, str) else tuple(spec) for what, spec in groups.items()}
+    size = len(names["output"])
+    for what, group in names.items():
+        if len(group) != size or not group:
+            raise WiringError(f"select {name}: {what} must name as many signals as output (at least one); got "
+                              f"{list(group)} for output {list(names['output'])}")
+    if not isinstance(flag, str):
+        raise WiringError(f"select {name}: flag must be one signal name, got {flag!r}")
+    read = (flag,) + names["on"] + names["off"]
+    repeated = sorted({n for n in read if read.count(n) > 1} | (set(read) & set(names["output"])))
+    if repeated:
+        raise WiringError(f"select {name}: flag, on, off and output must name different signals; repeated: {repeated}")
+    reads = Signals(read, ("",) + (unit,) * 2 * size, ("switch (0/1)",) + ("when set",) * size + ("when clear",) * size,
+                    "read")
+    publishes = Signals(names["output"], (unit,) * size, (f"{flag} ? on : off",) * size, "published")
+    return block(name, step=lambda s, r: (s, ca.if_else(r[0] > 0.5, r[1:1 + size], r[1 + size:])), reads=reads,
+                 publishes=publishes, description=f"{', '.join(names['output'])} = {flag} ? "
+                                                  f"{', '.join(names['on'])} : {', '.join(names['off'])}")
