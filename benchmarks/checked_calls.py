@@ -10,13 +10,13 @@ the symbolic graph (mapaccum or generated C) and pay nothing.
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import finish  # noqa: E402
+from rhs import median_time  # noqa: E402
 
 import uvsym  # noqa: E402
 from uvsym.observers.luenberger import luenberger_observer  # noqa: E402
@@ -24,17 +24,6 @@ from uvsym.observers.luenberger import luenberger_observer  # noqa: E402
 RESULTS = Path(__file__).resolve().parent / "results" / "checked_calls.json"
 TARGETS = {"model_f_ratio_max": 3.0, "system_f_ratio_max": 3.0, "observer_step_ratio_max": 3.0,
            "worst_overhead_us_max": 100.0}
-
-
-def median_time(call, repeat: int = 7, number: int = 2000) -> float:
-    """Median seconds per call over ``repeat`` batches of ``number`` calls."""
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            call()
-        times.append((time.perf_counter() - start) / number)
-    return float(np.median(times))
 
 
 def main() -> dict:
