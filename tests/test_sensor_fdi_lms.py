@@ -30,19 +30,26 @@ def test_both_criteria_fire_at_the_fault_and_the_heading_settles_off_by_the_faul
     assert np.mean(np.degrees(fault_run.result["y"]["psi"][-50:])) == pytest.approx(SET_POINT_DEG, abs=2.0)
 
 
-def test_ftc_substitutes_after_confirmation_and_a_spike_is_a_disturbance():
+def test_ftc_acts_on_the_substitute_from_the_confirming_sample_and_a_spike_is_a_disturbance():
     ftc = run(Run(size_deg=30.0, **SHORT))
-    confirmed = ftc.supervisor.first("R alarm").sample - SHORT["warm_up"]
-    switched = ftc.supervisor.first("substitution on").sample + 1 - SHORT["warm_up"]
-    assert switched == confirmed + 1
     k = ftc.k
-    on = ftc.result["substitution"]["psi"]
-    assert np.all(on[k < switched] == 0) and np.all(on[k >= switched] == 1)
+    confirmed = ftc.supervisor.first("R alarm").sample - SHORT["warm_up"]
+    assert confirmed == first_sample(ftc.monitor("alarm_R_psi"), k, FAULT_SAMPLE)
+    # the controller's reading is the compass before the confirming sample and the frozen filter's
+    # substitute from that very sample on; its command is kp (psi_ref - reading) of the same sample
+    measured, substitute, used = ftc.result["y"]["psi"], ftc.monitor("psi_sub"), ftc.result["ftc"]["psi_sel"]
+    np.testing.assert_array_equal(used[k < confirmed], measured[k < confirmed])
+    np.testing.assert_array_equal(used[k >= confirmed], substitute[k >= confirmed])
+    assert abs(measured[k == confirmed][0] - substitute[k == confirmed][0]) > np.radians(20.0)  # not the same value
+    kp = design().kp
+    np.testing.assert_allclose(ftc.result["u"]["u"], np.clip(kp * (np.radians(SET_POINT_DEG) - used), -1, 1),
+                               rtol=0, atol=1e-12)
+    assert np.array_equal(ftc.substituted(), k >= confirmed)
     spike = run(Run(size_deg=10.0, profile="pulse", **SHORT))
     whats = [e.what for e in spike.supervisor.events if e.sample >= SHORT["warm_up"]]
     assert whats[0].startswith("eps2 alarm") and whats[1].startswith("no R alarm")
-    assert not any(w.startswith("substitution") for w in whats)
-    assert not spike.result["substitution"]["psi"].any()
+    assert not spike.substituted().any()
+    np.testing.assert_array_equal(spike.result["ftc"]["psi_sel"], spike.result["y"]["psi"])
 
 
 def test_heading_gain_sets_the_natural_frequency_of_the_linearised_loop():

@@ -9,7 +9,10 @@ thresholds eps0 and r0, the R window n, the noise, the run length and the initia
 The loop: a set-point table publishes ``psi_ref``; a proportional heading controller (the
 paper's PID with ``ki = kd = 0``: an integral winds up on the faulty samples before the fault is
 confirmed and then turns the vehicle open loop, see the report) reads ``psi`` and publishes
-``u``; the LMS-FIR monitor reads ``psi``, ``u`` and ``psi_ref``. Its gain gives the loop of the
+``u``; the LMS-FIR monitor reads ``psi``, ``u`` and ``psi_ref``. With fault-tolerant control a
+switch block (:func:`uvsym.sim.blocks.select`) publishes ``psi_sel = flag ? psi_sub : psi`` in
+the same sample (flag: the monitor's ``fault_psi``, or ``frozen_psi`` to substitute from the
+eps^2 alarm) and the controller reads ``psi_sel`` instead. Its gain gives the loop of the
 linearised yaw model ``psi / u = K / (s (T s + 1))`` the natural frequency ``BANDWIDTH``
 (``K kp = T BANDWIDTH^2``; damping ratio ``1 / (2 T BANDWIDTH)``, 1.4: no overshoot). A seeded
 white yaw torque and compass noise excite the loop.
@@ -21,11 +24,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 
 import uvsym
 from uvsym.observers.base import Observer
 from uvsym.observers.lms import lms_monitor
+from uvsym.observers.lms_supervisor import switch_flag
 from uvsym.sim import observer_block
+from uvsym.sim.blocks import select
 from uvsym.sim.feedback import open_loop, pid
 from uvsym.systems.signals import signals
 from uvsym.systems.system import System
@@ -63,40 +69,57 @@ class Design:
     blocks: tuple
 
 
-def _yaw_model(plant: System) -> tuple[float, float]:
+def yaw_model(plant: System) -> tuple[float, float]:
     """(T, K) of the linearised yaw model ``psi / u = K / (s (T s + 1))``: T in s, K in rad/s per unit u."""
     lin = plant.linearize()
     T = -1.0 / lin.A[1, 1]  # m66 / |N_r|
     return T, lin.B[1, 0] * T
 
 
+def turn_rate(plant: System, u: float) -> float:
+    """The steady yaw rate (rad/s, >= 0) of the nonlinear yaw model under a constant command of size
+    ``|u|`` (0 < |u| <= 1) and no torque: the root of ``r' = 0``."""
+    def acceleration(r: float) -> float:
+        return float(plant.f([0.0, r], [abs(u)], [0.0], plant.p0)[1])
+
+    return float(brentq(acceleration, 0.0, 100.0))
+
+
 def heading_gain(plant: System, bandwidth: float = BANDWIDTH) -> float:
     """kp (per rad) of ``u = kp (psi_ref - psi)``: the linearised loop's natural frequency is ``bandwidth`` (rad/s)."""
-    T, K = _yaw_model(plant)
+    T, K = yaw_model(plant)
     return T * bandwidth ** 2 / K
 
 
 def pi_gains(plant: System) -> tuple[float, float]:
     """(kp per rad, ki per rad s) of a PI heading law placing the linearised loop's three poles at
     ``-1 / (3 T)`` (``T s^3 + s^2 + K kp s + K ki``, the fastest triple pole without derivative)."""
-    T, K = _yaw_model(plant)
+    T, K = yaw_model(plant)
     a = 1.0 / (3.0 * T)
     return 3.0 * a ** 2 * T / K, a ** 3 * T / K
 
 
 def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0: float = R0, window: int = WINDOW,
            hold: int = HOLD, confirm: int = CONFIRM, set_point_deg: float = SET_POINT_DEG,
-           bandwidth: float = BANDWIDTH, integral: bool = False) -> Design:
+           bandwidth: float = BANDWIDTH, integral: bool = False, substitute_on: str | None = None) -> Design:
     """The plant, the monitor and the heading loop's blocks (ObserverError for bad monitor settings);
-    ``integral``: the PI law of :func:`pi_gains` instead of the proportional one."""
+    ``integral``: the PI law of :func:`pi_gains` instead of the proportional one; substitute_on:
+    None (the controller reads the compass), ``"fault"`` or ``"alarm"`` (it reads ``psi_sel``,
+    switched in the same sample by the flag of :func:`uvsym.observers.lms_supervisor.switch_flag`)."""
     plant = uvsym.plant("rov_yaw")
     monitor = lms_monitor(plant.y, plant.u, reference=signals(("psi_ref", "rad", "heading set-point")),
                           order=order, mu=mu, eps0=eps0_deg2 * (math.pi / 180.0) ** 2, r0=r0, dt=DT, window=window,
                           hold=hold, confirm=confirm, name="lms")
     kp, ki = pi_gains(plant) if integral else (heading_gain(plant, bandwidth), 0.0)
     reference = open_loop("reference", [0.0], [math.radians(set_point_deg)], publishes=["psi_ref"])
-    controller = pid("heading", "psi", "psi_ref", output="u", kp=kp, ki=ki, limits=(-1.0, 1.0), dt=DT)
-    return Design(plant, monitor, kp, (reference, controller, observer_block(monitor)))
+    blocks = (reference, observer_block(monitor))
+    measured = "psi"
+    if substitute_on is not None:
+        measured = "psi_sel"
+        blocks += (select("ftc", flag=switch_flag("psi", substitute_on), on="psi_sub", off="psi", output=measured,
+                          unit=plant.y.unit("psi")),)
+    controller = pid("heading", measured, "psi_ref", output="u", kp=kp, ki=ki, limits=(-1.0, 1.0), dt=DT)
+    return Design(plant, monitor, kp, (reference, controller) + blocks[1:])
 
 
 def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:

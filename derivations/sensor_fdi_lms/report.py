@@ -29,24 +29,29 @@ PAPER = {"eps2_first_alarm_sample": 70, "R_first_alarm_sample": 75,
          "spike_classified_as": "disturbance"}
 SETTLED = 100  # samples (20 s) at the end of the record whose mean heading is the settled heading
 FTC_WINDOW = 300  # samples (60 s) after the onset over which the FTC error is taken
+TRANSIENT = 10  # samples (2 s) after the switch by which the turn begun on the faulty samples has died out
 FTC_SEEDS = tuple(range(8))  # noise seeds of the FTC robustness runs
 BANDWIDTHS = (0.35, D.BANDWIDTH, 1.4)  # rad/s, the proportional law's natural frequencies compared
 STEPS = (D.MU, 1e3, 1e4, 1e5)  # LMS steps compared (the paper's, and larger ones that let the filter learn)
 
 
 def _summary(outcome) -> dict:
-    """Alarm samples, settled heading and the largest heading error over FTC_WINDOW after the onset."""
+    """Alarm samples, the samples the controller read the substitute, settled heading and the
+    largest heading error over FTC_WINDOW after the onset."""
     k, heading = outcome.k, outcome.heading_deg()
     after = (k >= D.FAULT_SAMPLE) & (k < D.FAULT_SAMPLE + FTC_WINDOW)
     confirmed = outcome.supervisor.first("R alarm")
-    switched = outcome.supervisor.first("substitution on")
+    substituted = outcome.substituted() & (k >= 0)
+    largest = int(np.argmax(np.where(after, np.abs(heading - D.SET_POINT_DEG), -1.0)))
     return {"eps2_first_alarm_sample": first_sample(outcome.monitor("alarm_eps2_psi"), k),
             "R_first_alarm_sample": first_sample(outcome.monitor("alarm_R_psi"), k, D.FAULT_SAMPLE),
             "R_first_above_sample": first_sample(outcome.monitor("R_psi") > D.R0, k, D.FAULT_SAMPLE),
             "confirmed_sample": None if confirmed is None else confirmed.sample - outcome.spec.warm_up,
-            "substituted_from_sample": None if switched is None else switched.sample + 1 - outcome.spec.warm_up,
+            "substituted_from_sample": first_sample(substituted, k),
+            "substituted_samples": int(np.sum(substituted)),
             "settled_heading_deg": float(np.mean(heading[-SETTLED:])),
-            "max_abs_heading_error_deg": float(np.max(np.abs(heading[after] - D.SET_POINT_DEG))),
+            "max_abs_heading_error_deg": float(np.abs(heading[largest] - D.SET_POINT_DEG)),
+            "max_abs_heading_error_sample": int(k[largest]),
             "events": [[e.sample - outcome.spec.warm_up, e.what] for e in outcome.supervisor.events
                        if e.sample >= outcome.spec.warm_up]}
 
@@ -66,6 +71,22 @@ def _runs(progress) -> tuple[dict, dict]:
         outcomes[label] = run(Run(size_deg=D.FAULT_SIZES_DEG[-1], profile="pulse", length=1, substitute_on=mode))
         summaries[label] = _summary(outcomes[label])
     return outcomes, summaries
+
+
+def _transient(outcome) -> dict:
+    """What the controller did on the faulty samples before the switch: their number, its mean
+    command (-), the steady turn rate that command would reach and the peak yaw rate (deg/s), and
+    the heading error (deg) at the switch and TRANSIENT samples after it."""
+    k, error = outcome.k, outcome.heading_deg() - D.SET_POINT_DEG
+    switch = first_sample(outcome.substituted(), k, D.FAULT_SAMPLE)
+    acting = (k >= D.FAULT_SAMPLE) & (k < switch)
+    turning = (k >= D.FAULT_SAMPLE) & (k < switch + TRANSIENT)
+    command = float(np.mean(outcome.result["u"]["u"][acting]))
+    return {"faulty_samples": int(np.sum(acting)),
+            "command": command, "steady_turn_deg_s": math.degrees(D.turn_rate(D.design().plant, command)),
+            "peak_yaw_rate_deg_s": float(np.max(np.abs(np.degrees(outcome.result["x"]["r"][turning])))),
+            "error_at_switch_deg": float(error[k == switch][0]),
+            "error_after_transient_deg": float(error[k == switch + TRANSIENT][0])}
 
 
 def _max_error(spec: Run) -> float:
@@ -142,7 +163,8 @@ def build(out_dir: Path, progress) -> None:
                    out_dir / "fig4a_heading_without_ftc.svg", "Without fault-tolerant control", substitute=False)
     heading_figure({f"+{s:g} deg": outcomes[(s, "ftc")] for s in D.FAULT_SIZES_DEG},
                    out_dir / "fig4b_heading_with_ftc.svg",
-                   "With fault-tolerant control (substitution once the fault is confirmed)", substitute=True)
+                   "With fault-tolerant control (substitute read from the sample the fault is confirmed)",
+                   substitute=True)
     roc_figure(study.roc, out_dir / "roc.svg")
     delay_figure(study.delays, out_dir / "detection_delay.svg")
     paper_run = summaries["30"]["ftc"]
@@ -157,6 +179,9 @@ def build(out_dir: Path, progress) -> None:
             "max_abs_heading_error_deg"] for size in ftc},
         "spike_classified_as": _classified(summaries["spike"]),
         "spike_substituted": summaries["spike"]["substituted_from_sample"] is not None,
+        "transient": {size: _transient(outcomes[(float(size), "ftc")]) for size in ftc},
+        "plant": {"yaw_time_constant_s": D.yaw_model(D.design().plant)[0],
+                  "full_thrust_turn_deg_s": math.degrees(D.turn_rate(D.design().plant, 1.0))},
         "runs": summaries, "robustness": robustness, "steps": steps,
         "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
         "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
