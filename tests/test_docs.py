@@ -54,3 +54,32 @@ def test_sphinx_builds_the_documentation_without_a_warning(tmp_path):
     page = (tmp_path / "html" / "api.html").read_text()
     assert "synthesize_observer_gain" in page or "linearisation_claim" in page
     assert (tmp_path / "html" / "tutorial.html").exists()
+
+
+def test_readme_scenario_schema_is_the_validators():
+    from uvsym.sim.schema import schema_markdown
+
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index("<!-- scenario-schema -->") + len("<!-- scenario-schema -->"):
+                   readme.index("<!-- /scenario-schema -->")].strip()
+    assert block == schema_markdown(), "README's schema is stale: paste the output of uvsym simulate --schema"
+
+
+def test_the_schema_names_every_field_a_shipped_scenario_uses_and_the_rules():
+    from uvsym.sim.schema import scenario_schema
+
+    fields = {row["field"]: row for row in scenario_schema()}
+    assert fields["duration"]["default"] == "required" and fields["duration"]["rule"] == "> 0"
+    assert fields["faults[].profile"]["rule"] == "one of step, ramp, incipient, intermittent"
+    assert fields["current.speed"]["rule"] == ">= 0" and fields["current.speed"]["default"] == "0"
+    assert "faults[].end" in fields and "controller.outputs.<loop>" in fields
+
+
+@pytest.mark.slow
+def test_the_readme_python_examples_run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    assert len(blocks) >= 4
+    namespace: dict = {"__name__": "readme"}
+    for index, block in enumerate(blocks, 1):
+        exec(compile(block, f"README.md, python block {index}", "exec"), namespace)  # noqa: S102

@@ -180,6 +180,11 @@ def _cmd_simulate(args) -> int:
     from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
     from uvsym.sim.simulation import simulate_scenario
 
+    if args.schema:
+        from uvsym.sim.schema import schema_markdown
+
+        print(schema_markdown())
+        return 0
     if args.list or not args.scenario:
         rows = [[name, "", str(path.name)] for name, path in shipped_scenarios().items()]
         rows += [[name, study, str(path.name)] for name, (study, path) in study_scenarios().items()]
@@ -332,6 +337,8 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", nargs="?", const="", default=None,
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
+    simulate.add_argument("--schema", action="store_true", help="print every field of a vehicle scenario file "
+                                                                "(type, default, rule) as a Markdown table")
     simulate.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     simulate.set_defaults(run=_cmd_simulate)
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "

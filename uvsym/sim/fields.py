@@ -1,9 +1,14 @@
 """Typed access to one table of a TOML file: every read names its field (``faults[2].kind``) in
-the :class:`~uvsym.errors.ScenarioError` it raises, and keys nobody read are refused."""
+the :class:`~uvsym.errors.ScenarioError` it raises, and keys nobody read are refused.
+
+Given a ``schema`` dict, every read also records the field it reads (``faults[].kind``: type,
+default, rule), so that the documented schema is what the validator reads and cannot drift.
+"""
 
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -15,23 +20,43 @@ __all__ = ["Fields"]
 class Fields:
     """Typed access to one TOML table that remembers its path and rejects unknown keys."""
 
-    def __init__(self, data, path: str):
+    def __init__(self, data, path: str, schema: dict | None = None):
         if not isinstance(data, dict):
             raise ScenarioError(f"{path or 'scenario'}: expected a table, got {type(data).__name__}")
-        self.data, self.path, self.used = data, path, set()
+        self.data, self.path, self.used, self.schema = data, path, set(), schema
 
     def _name(self, key: str) -> str:
         return f"{self.path}.{key}" if self.path else key
 
+    def _record(self, key: str, kind: str, default, rule: str = "", shown: str | None = None) -> None:
+        if self.schema is not None:
+            field = re.sub(r"\[\d+\]", "[]", self._name(key))
+            if shown is None:
+                shown = "required" if default is None else (
+                    "zeros" if isinstance(default, list) and default and not any(default) else
+                    f"{default:g}" if isinstance(default, float) else repr(default))
+            self.schema.setdefault(field, {"field": field, "type": kind, "default": shown, "rule": rule})
+
     def has(self, key: str) -> bool:
         return key in self.data
 
-    def raw(self, key: str, default=None):
+    def raw(self, key: str, default=None, kind: str = "any", rule: str = ""):
+        """The value as parsed; ``kind`` and ``rule`` only describe it for the schema."""
+        self._record(key, kind, default, rule)
         self.used.add(key)
         return self.data.get(key, default)
 
+    def describe(self, key: str, kind: str, rule: str, default: str = "required") -> None:
+        """Describe, for the schema only, a field read another way (e.g. keys that are data)."""
+        self._record(key, kind, None, rule, shown=default)
+
+    def empty(self, key: str) -> Fields:
+        """An empty table standing for the optional table ``key`` (its fields' defaults apply)."""
+        return Fields({}, self._name(key), self.schema)
+
     def number(self, key: str, default=None, *, positive: bool = False, minimum: float | None = None) -> float:
-        value = self.raw(key, default)
+        rule = "> 0" if positive else (f">= {minimum:g}" if minimum is not None else "finite")
+        value = self.raw(key, default, "number", rule)
         if value is None:
             raise ScenarioError(f"{self._name(key)}: required number is missing")
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -43,7 +68,7 @@ class Fields:
         return float(value)
 
     def text(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
-        value = self.raw(key, default)
+        value = self.raw(key, default, "string", "" if choices is None else "one of " + ", ".join(choices))
         if not isinstance(value, str):
             raise ScenarioError(f"{self._name(key)}: expected a string, got {value!r}")
         if choices is not None and value not in choices:
@@ -51,7 +76,9 @@ class Fields:
         return value
 
     def vector(self, key: str, size: int, default=None) -> np.ndarray | None:
-        value = self.raw(key, default)
+        self._record(key, "list of numbers", default, "finite, one per entry", None if default is not None else "none")
+        self.used.add(key)
+        value = self.data.get(key, default)
         if value is None:
             return None
         array = np.asarray(value, dtype=object)
@@ -63,14 +90,18 @@ class Fields:
         return result
 
     def table(self, key: str) -> Fields | None:
-        value = self.raw(key)
-        return None if value is None else Fields(value, self._name(key))
+        self._record(key, "table", None, shown="optional")
+        self.used.add(key)
+        value = self.data.get(key)
+        return None if value is None else Fields(value, self._name(key), self.schema)
 
     def tables(self, key: str) -> list[Fields]:
-        value = self.raw(key, [])
+        self._record(key, "array of tables", None, f"[[{self._name(key)}]]", shown="none")
+        self.used.add(key)
+        value = self.data.get(key, [])
         if not isinstance(value, list):
             raise ScenarioError(f"{self._name(key)}: expected an array of tables ([[{key}]])")
-        return [Fields(item, f"{self._name(key)}[{i}]") for i, item in enumerate(value)]
+        return [Fields(item, f"{self._name(key)}[{i}]", self.schema) for i, item in enumerate(value)]
 
     def done(self) -> None:
         unknown = sorted(set(self.data) - self.used)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.errors import FaultError, KinematicsError, ModelError, ObserverError, ScenarioError, UnknownNameError
-from uvsym.faults import ActuatorFault, Profile, SensorFault, actuator_kind
+from uvsym.faults import ACTUATOR_KINDS, PROFILES, SENSOR_KINDS, ActuatorFault, Profile, SensorFault, actuator_kind
 from uvsym.kinematics import Tzyx
 from uvsym.models.model import Model
 from uvsym.models.registry import vehicle
@@ -96,13 +96,15 @@ def load_scenario(source) -> Scenario:
     return parse_scenario(read_scenario_file(path), default_name=path.stem)
 
 
-def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
-    """Validate a scenario given as a dict (the parsed TOML)."""
-    top = _Fields(data, "")
+def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | None = None) -> Scenario:
+    """Validate a scenario given as a dict (the parsed TOML); ``schema`` collects the fields read
+    (:func:`scenario_schema`)."""
+    top = _Fields(data, "", schema)
+    top.describe("name", "string", "", "the file's name")
     name = top.text("name", default_name)
     description = top.text("description", "")
     vehicle_name = top.text("vehicle")
-    overrides = top.raw("vehicle_parameters", {})
+    overrides = top.raw("vehicle_parameters", {}, "table", "parameter = value overrides (uvsym models show VEHICLE)")
     if not isinstance(overrides, dict):
         raise ScenarioError("vehicle_parameters: expected a table of parameter = value")
     try:
@@ -111,15 +113,15 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
         raise ScenarioError(f"vehicle: {exc}") from None
     dof, m = model.dof, model.n_inputs
     duration, step = top.number("duration", positive=True), top.number("step", positive=True)
-    observer_items = top.raw("observers", [])
+    observer_items = data.get("observers", [])
     _check_size(duration, step, model, len(observer_items) if isinstance(observer_items, list) else 0)
     if abs(round(duration / step) * step - duration) > 1e-9 * duration:
         raise ScenarioError(f"step: {step} s does not divide duration {duration} s")
-    seed = top.raw("seed", 0)
+    seed = top.raw("seed", 0, "integer", ">= 0 (noise and current draws)")
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise ScenarioError(f"seed: expected a non-negative integer, got {seed!r}")
 
-    initial = top.table("initial") or _Fields({}, "initial")
+    initial = top.table("initial") or top.empty("initial")
     eta0 = initial.vector("eta", dof, [0.0] * dof)
     if dof == 6:
         try:
@@ -130,12 +132,13 @@ def parse_scenario(data: dict, default_name: str = "scenario") -> Scenario:
     actuators0 = initial.vector("actuators", m)
     initial.done()
 
-    current = top.table("current") or _Fields({}, "current")
+    current = top.table("current") or top.empty("current")
     V_c = current.number("speed", 0.0, minimum=0.0)
     beta_c = math.radians(current.number("direction_deg", 0.0))
     variation = (current.number("speed_std", 0.0, minimum=0.0), current.number("time_constant", 10.0, positive=True))
     current.done()
 
+    top.describe("controller", "table", "the loops and the path")
     controller = _controller(top.table("controller"), model)
     actuator_faults, sensor_faults = _faults(top.tables("faults"), model, duration)
     observers = _observers(top.tables("observers"), model)
@@ -165,7 +168,7 @@ def _controller(fields: _Fields | None, model: Model) -> Autopilot:
     path = None
     path_fields = fields.table("path")
     if path_fields is not None:
-        points = path_fields.raw("waypoints")
+        points = path_fields.raw("waypoints", None, "list of [north, east] pairs", "finite, m")
         if not isinstance(points, list) or not all(isinstance(p, list) and len(p) == 2 for p in points):
             raise ScenarioError("controller.path.waypoints: expected a list of [north, east] pairs (m)")
         for i, point in enumerate(points):
@@ -178,14 +181,18 @@ def _controller(fields: _Fields | None, model: Model) -> Autopilot:
                            acceptance=path_fields.number("acceptance", 2.0, minimum=0.0),
                            turn_radius=path_fields.number("turn_radius", 0.0, minimum=0.0))
         path_fields.done()
+    fields.describe("outputs", "table", "which inputs each loop drives")
     outputs_fields = fields.table("outputs")
     if outputs_fields is None:
         raise ScenarioError("controller.outputs: required table is missing (which inputs each loop drives)")
+    outputs_fields.describe("<loop>", "table", "speed, yaw or pitch = {input label = weight, ...}: the inputs "
+                            "the loop drives")
     outputs = {}
     for channel in list(outputs_fields.data):
-        mix = outputs_fields.table(channel)
+        mix = _Fields(outputs_fields.data[channel], f"controller.outputs.{channel}")  # its keys are data
+        outputs_fields.used.add(channel)
         outputs[channel] = {label: mix.number(label) for label in list(mix.data)}
-    model_based = fields.raw("model_based", False)
+    model_based = fields.raw("model_based", False, "boolean")
     if not isinstance(model_based, bool):
         raise ScenarioError(f"controller.model_based: expected true or false, got {model_based!r}")
     fields.done()
@@ -197,7 +204,8 @@ def _controller(fields: _Fields | None, model: Model) -> Autopilot:
 
 def _profile(fields: _Fields) -> Profile:
     defaults = Profile()
-    kwargs = {"kind": fields.text("profile", "step")}
+    kwargs = {"kind": fields.text("profile", "step", choices=PROFILES)}
+    fields.describe("end", "number", "> onset, s: the fault stops (faults that come and go)", "none")
     for key in _PROFILE_KEYS[1:]:
         if key != "end" or fields.has(key):
             kwargs[key] = fields.number(key, getattr(defaults, key))
@@ -209,6 +217,10 @@ def _faults(items: list[_Fields], model: Model, duration: float):
     can never act (onset outside [0, duration), a value that changes nothing, a negative factor)."""
     actuator, sensor = [], []
     for fields in items:
+        fields.describe("actuator", "string", "an input label of the vehicle (an actuator fault)", "one of the two")
+        fields.describe("sensor", "string", "a state label of the vehicle (a sensor fault)", "one of the two")
+        fields.describe("kind", "string", f"with actuator: {', '.join(ACTUATOR_KINDS)}; with sensor: "
+                                          f"{', '.join(SENSOR_KINDS)}")
         try:
             if fields.has("actuator"):
                 label = fields.text("actuator", choices=model.input_labels)
