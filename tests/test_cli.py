@@ -260,3 +260,17 @@ def test_the_source_fingerprint_moves_with_any_source_file_of_the_study(tmp_path
     assert source_fingerprint(study) == before
     (package / "data.json").write_text('{"gain": 2.0}\n')
     assert source_fingerprint(study) != before
+
+
+def test_verify_prints_each_claim_readably_in_100_columns(tmp_path, capsys):
+    from uvsym.cli import _claim_block
+
+    assert main(["verify", "motor-luenberger", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines() if str(tmp_path) not in line) <= 100
+    assert out.count("   claim:  ") == len(json.loads((tmp_path / "motor-luenberger" / "proofs.json").read_text()))
+    words = "the error map of the sampled observer contracts at every vertex of the polytope " * 4
+    block = _claim_block({"claim": words, "set": "s", "method": "m", "status": "refuted", "expected": "proved",
+                          "margin": None, "seconds": 1.0})
+    assert block.startswith("!! REFUTED (expected proved") and "polytope" in block
+    assert all(len(line) <= 100 and not line.endswith(("contra", "verte")) for line in block.splitlines())

@@ -271,6 +271,21 @@ def _set_options(name: str, factory, tokens: list[str]) -> dict:
     return options
 
 
+def _claim_block(row: dict, width: int = 100) -> str:
+    """One claim for the terminal, no line wider than ``width``: its status line, then the claim,
+    the set and the method wrapped at word boundaries."""
+    import textwrap
+
+    mark = "  " if row["status"] == row["expected"] else "!!"
+    margin = "" if row["margin"] is None else f", margin {row['margin']:.3g}"
+    head = f"{mark} {row['status'].upper()} (expected {row['expected']}{margin}, {row['seconds']:.2f} s)"
+    lines = [head]
+    for label in ("claim", "set", "method"):
+        lines += textwrap.wrap(str(row[label]), width, initial_indent=f"   {label + ':':8}",
+                               subsequent_indent=" " * 11, break_on_hyphens=False) or [f"   {label}:"]
+    return "\n".join(lines)
+
+
 def _cmd_verify(args) -> int:
     import time
 
@@ -289,11 +304,9 @@ def _cmd_verify(args) -> int:
         write_json(out_dir / "proofs.json", [{**row, "seconds": round(row["seconds"], 3)} for row in rows])
         everything += [{"derivation": name, **row} for row in rows]
         if not args.json:
-            print(f"{name}: {len(rows)} claims in {time.perf_counter() - started:.1f} s "
-                  f"(written to {out_dir / 'proofs.json'})")
-            print(_table([[r["claim"], r["set"][:40], r["method"][:40], r["status"], r["expected"],
-                           "-" if r["margin"] is None else f"{r['margin']:.3g}", f"{r['seconds']:.2f}"]
-                          for r in rows], ["claim", "set", "method", "status", "expected", "margin", "s"]) + "\n")
+            print(f"{name}: {len(rows)} claims in {time.perf_counter() - started:.1f} s, written to\n"
+                  f"  {out_dir / 'proofs.json'}")
+            print("\n\n".join(_claim_block(r) for r in rows) + "\n")
     if args.json:
         print(json.dumps(everything, indent=2))
     else:
