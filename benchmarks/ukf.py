@@ -16,9 +16,6 @@ loop (``time.process_time``); compare as ratios within one run: the machine is s
 
 from __future__ import annotations
 
-import json
-import os
-import platform
 import sys
 import tempfile
 import time
@@ -33,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import c_timing  # noqa: E402
 from c_timing import c_loop_ns  # noqa: E402
+from common import finish  # noqa: E402
 
 import uvsym  # noqa: E402
 from derivations.usv_fukf_mmae.experiment import MODELS, TUNING, bank, filters, simulate_plant  # noqa: E402
@@ -175,19 +173,13 @@ def main() -> dict:
             "speedup_vs_filterpy_mmae": fp_bank_us * 1e3 / bank_ns["cpu"],
             "wall_ukf_step_ns": ukf_ns["wall"], "wall_bank_step_ns": bank_ns["wall"],
             "filterpy_ukf_step_us": fp_ukf_us, "filterpy_bank_step_us": fp_bank_us,
-            "load_average_1min": os.getloadavg()[0], "cpus": os.cpu_count(),
             "casadi_vm_bank_step_us": vm_us, "samples_filterpy": SAMPLES,
             "max_probability_difference_vs_filterpy": float(np.max(np.abs(uvsym_p - fp_p))),
-            "sx_instructions": {"ukf_step": left.step.n_instructions(), "bank_step": ukf_bank.step.n_instructions()},
-            "targets": {"ukf_step_ns_max": 3000, "bank_step_ns_max": 10000, "speedup_min": 100},
-            "machine": {"python": platform.python_version(), "casadi": ca.__version__,
-                        "processor": platform.machine()}}
+            "sx_instructions": {"ukf_step": left.step.n_instructions(), "bank_step": ukf_bank.step.n_instructions()}}
 
 
 if __name__ == "__main__":
     if find_compiler() is None:
         sys.exit("no C compiler: nothing to measure")
-    results = main()
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(results, indent=2) + "\n")
-    print(json.dumps(results, indent=2))
+    finish(main(), {"ukf_step_ns_max": 3000, "bank_step_ns_max": 10000, "speedup_vs_filterpy_ukf_min": 100,
+                    "speedup_vs_filterpy_mmae_min": 100}, RESULTS)

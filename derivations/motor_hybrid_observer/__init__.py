@@ -1,4 +1,4 @@
-"""The incipient sensor-fault paper (Yu, Jiang & Zhang 2018) on uvsym's induction motor: its hybrid
+"""Yu et al. 2018 (:mod:`derivations.papers`) on uvsym's induction motor: its hybrid
 unknown-input / adaptive observer, its LMI theorems checked by machine (refuted for this motor, with
 exact evidence) and a corrected design that uvsym proves.
 

@@ -1,4 +1,4 @@
-"""The incipient sensor-fault paper's observers on uvsym's induction motor, and the corrected design.
+"""Yu et al. 2018's observers on uvsym's induction motor, and the corrected design.
 
 Plant: ``uvsym.plant("induction_motor")`` (the paper's eq. 23, MSL parameters), linearised at its
 operating point; its E is the paper's (the disturbance ``d = dRr x``), the speed-sensor fault

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from derivations.motor_hybrid_observer.design import design
+from derivations.papers import paper
 from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
 
@@ -14,6 +15,7 @@ def motor_hybrid() -> ObserverSet:
     of the induction motor, one step of 0.1 ms each."""
     observers = design().observers
     return ObserverSet("uvsym_motor_hybrid", "Induction motor: hybrid UIO detection observer and adaptive fault "
-                       "estimator (Yu, Jiang & Zhang 2018), baseline UIO, corrected design",
+                       "estimator (Yu et al. 2018), baseline UIO, corrected design",
                        tuple(exported_observer(observers[name]) for name in ("detection", "estimator", "baseline",
-                                                                             "corrected")))
+                                                                             "corrected")),
+                       citation=paper("yu2018").reference())

@@ -19,10 +19,13 @@ from derivations.motor_luenberger.experiment import (
     NOISE,
     THRESHOLD_FACTOR,
 )
+from derivations.papers import paper
 from uvsym.report import markdown_table
 from uvsym.report.sections import c_section, claims_table
 
 __all__ = ["report_text"]
+
+YU = paper("yu2018")
 
 
 def _t(value) -> str:
@@ -92,7 +95,9 @@ def report_text(r: dict, figures: list[tuple[str, str]]) -> str:
     figs = "\n\n".join(f"![{caption}]({name})" for name, caption in figures)
     return f"""# Incipient speed-sensor faults: the hybrid unknown-input / adaptive observer, machine-checked
 
-Yu, Jiang & Zhang (2018) split the induction motor into a subsystem with the rotor-resistance
+Paper: {YU.reference()}
+
+Yu et al. 2018 split the induction motor into a subsystem with the rotor-resistance
 disturbance (currents and fluxes, an unknown-input observer) and one with the speed-sensor fault
 (the speed, a Luenberger detection observer and an adaptive PI fault estimator), and state two
 LMI theorems for the gains. This report runs their observers (`uvsym.observers.hybrid`) on

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from derivations.papers import paper
 from derivations.sensor_fdi_lms.design import MU, ORDER, design
 from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
@@ -23,5 +24,4 @@ def lms_set(order: int = ORDER, mu: float = MU) -> ObserverSet:
                     f"LMS-FIR step of order {order}: d = C.U, e = d - target, C_next = C - 2 mu e U")
     return ObserverSet("uvsym_sensor_fdi_lms", f"LMS-FIR compass monitor, order {order}, double criterion",
                        (exported_observer(monitor), bare),
-                       citation="Zhu Daqi et al., sensor fault diagnosis of an underwater robot with an adaptive "
-                                "FIR filter (LMS), double criterion and measurement substitution")
+                       citation=paper("zhu-lms").reference())
