@@ -29,6 +29,11 @@ def _final(run: dict, key: str) -> float:
     return float(np.mean(run[key][run["t"] >= DURATION - FINAL_WINDOW]))
 
 
+def _ratio(run: dict) -> float:
+    """The hybrid estimator's final estimate over the true fault (means over the last second)."""
+    return _final(run, "estimator_f_s_hat") / _final(run, "f_s")
+
+
 def _analytic_final(model, case: str, t: np.ndarray) -> float:
     window = t[t >= DURATION - FINAL_WINDOW][::100]
     return float(np.mean(estimate(model, case, window)))
@@ -141,6 +146,8 @@ def _results(cases: dict) -> dict:
         "case_a_final_estimate": a["estimator"], "case_b_final_estimate": b["estimator"],
         "case_a_final_estimate_ratio": a["estimator"] / a["true"],
         "case_b_final_estimate_ratio": b["estimator"] / b["true"],
+        "case_a_final_estimate_ratio_noise_free": _ratio(cases["runs"]["case a (incipient), noise-free"]),
+        "case_b_final_estimate_ratio_noise_free": _ratio(cases["runs"]["case b (step), noise-free"]),
         "case_a_final_estimate_analytic": a["estimator_analytic"],
         "case_b_final_estimate_analytic": b["estimator_analytic"],
         "step_estimate_limit_closed_form": step_limit(),
