@@ -5,7 +5,8 @@ A :class:`CheckedFunction` *is* a ``casadi.Function`` (``isinstance`` holds, ``m
 checked before CasADi sees it:
 
 - arguments given all by position (as many as the Function takes) or all by name (known names);
-- each argument of the Function's size (a scalar broadcasts, as in CasADi; an empty value for a
+- each argument of the Function's size (a scalar broadcasts, as in CasADi, but a one-entry list
+  for a vector does not; an empty value for a
   non-empty argument is refused instead of read as zeros);
 - every entry finite, and every output finite at finite inputs (a ``guard`` may refuse points
   outside the Function's domain, e.g. a kinematic singularity, before evaluating).
@@ -102,7 +103,8 @@ class CheckedFunction(ca.Function):
         vector = 1 in shape
         fits = value.size == 1 or (value.ndim <= 1 and vector) or value.shape in ((shape, shape[::-1]) if vector else
                                                                               (shape,))
-        if value.size not in (expected, 1) or (value.size == 1 and expected == 0) or not fits:
+        one_entry_list = value.ndim == 1 and value.size == 1 and expected > 1  # [x] for a vector: a mistake
+        if value.size not in (expected, 1) or (value.size == 1 and expected == 0) or not fits or one_entry_list:
             raise ArgumentError(f"{self._where()}: argument {name} has {value.size} entries (shape "
                                 f"{value.shape}), expected {expected} (shape {shape})")
         if not np.isfinite(value).all():

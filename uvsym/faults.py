@@ -186,6 +186,8 @@ class Profile:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Real) or math.isnan(value):
                 raise FaultError(f"fault profile {name} must be a number (s, 1/s or -), got {value!r}")
+        if not 0.0 <= self.onset < math.inf:
+            raise FaultError(f"fault profile onset must be a finite time >= 0 s (runs start at 0), got {self.onset}")
         if self.end <= self.onset:
             raise FaultError(f"fault profile end ({self.end} s) must be after its onset ({self.onset} s)")
         for name in ("duration", "rate", "period"):

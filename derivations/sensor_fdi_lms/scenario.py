@@ -1,6 +1,7 @@
 """``uvsym simulate FILE.toml`` with ``study = "sensor-fdi-lms"``: any fault, onset, size, sensor and profile.
 
-Tables and fields (all optional; defaults are the paper's 30 deg compass fault at sample 70)::
+Tables and fields (all optional; without a ``[fault]`` table the run has no fault; a ``[fault]``
+table's fields default to the paper's 30 deg compass bias at sample 70)::
 
     [fault]    sensor = "psi", kind = "bias" | "drift" | "stuck" | "noise", size_deg = 30.0 (none: no fault),
                onset_sample = 70, profile = "step" | "pulse" | "ramp" | "incipient" | "intermittent",
@@ -70,8 +71,11 @@ def run_from_table(table: dict) -> Run:
         else:
             value = _number(value, where, integer=isinstance(defaults[name], int) and name != "size_deg")
         spec[name] = value
+    if "fault" not in table:
+        spec["size_deg"] = None  # no [fault] table: a healthy run
     result = Run(**spec)
-    for where, name, low in (("run.warm_up_samples", "warm_up", 0), ("run.record_samples", "record", 1),
+    for where, name, low in (("run.seed", "seed", 0), ("run.warm_up_samples", "warm_up", 0),
+                             ("run.record_samples", "record", 1),
                              ("fault.onset_sample", "onset", 0), ("fault.length_samples", "length", 1)):
         if getattr(result, name) < low:
             raise ScenarioError(f"{where}: must be at least {low}, got {getattr(result, name)}")

@@ -99,9 +99,11 @@ def simulate_plant(scenario: Scenario, method: str = "fast", progress=None) -> S
     noise = tuple(SensorFault(plant.y.index(state), "noise", scenario.noise[state]) for state in STATES)
     first = scenario.path.segments()[0]
     x0 = [*first["start"], first["angle"], scenario.speed, 0.0, 0.0]
-    return simulate_system(plant, [guidance(scenario, plant)], duration=scenario.duration, dt=scenario.dt, x0=x0,
-                           method=method, d=disturbance, actuator_faults=faults, sensor_faults=noise,
-                           seed=scenario.seed + 1, compiled=False, progress=progress)
+    result = simulate_system(plant, [guidance(scenario, plant)], duration=scenario.duration, dt=scenario.dt, x0=x0,
+                             method=method, d=disturbance, actuator_faults=faults, sensor_faults=noise,
+                             seed=scenario.seed + 1, compiled=False, progress=progress)
+    result.meta.update(seed=scenario.seed, disturbance_seed=scenario.seed, noise_seed=scenario.seed + 1)
+    return result  # meta's seed is the scenario's (its disturbance draws); the noise draws use seed + 1
 
 
 def still_water(vehicle: str) -> System:

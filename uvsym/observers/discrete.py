@@ -24,6 +24,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
+from uvsym.errors import ObserverError
 from uvsym.faults import actuator_kind
 from uvsym.models.model import Model
 from uvsym.observers.actuator import actuator_observer
@@ -143,6 +144,13 @@ def actuator_fault_observer(model: Model, kind: str, dt: float, K, form: str = "
     continuous = actuator_observer(model, kind, form)
     sampled = sampled_observer(continuous.function, dt)
     n = model.dof
+    try:
+        gains = np.asarray(K, dtype=float).ravel()
+    except (TypeError, ValueError):
+        gains = np.empty(0)
+    if gains.size != n or not np.all(np.isfinite(gains)) or np.any(gains <= 0):
+        raise ObserverError(f"{name or kind} observer: the gains K must be {n} positive finite numbers (one per "
+                            f"force channel; a gain <= 0 makes the error grow), got {K!r}")
     forces = Signals(FORCE_LABELS[n], model.force_units, group="force")
     f_units = tuple(map(actuator_kind(kind).unit, model.force_units))
     states = Signals(model.state_labels, model.state_units, group="measurement")

@@ -7,6 +7,7 @@ default, rule), so that the documented schema is what the validator reads and ca
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 
@@ -37,6 +38,11 @@ class Fields:
                     f"{default:g}" if isinstance(default, float) else repr(default))
             self.schema.setdefault(field, {"field": field, "type": kind, "default": shown, "rule": rule})
 
+    def _misspelt(self, key: str) -> str:
+        """`` (is 'durration' a misspelt 'duration'?)`` when a key of the table is close to ``key``."""
+        near = difflib.get_close_matches(key, [str(k) for k in self.data if k != key], n=1, cutoff=0.75)
+        return f" (is {near[0]!r} a misspelt {key!r}?)" if near else ""
+
     def has(self, key: str) -> bool:
         return key in self.data
 
@@ -58,7 +64,7 @@ class Fields:
         rule = "> 0" if positive else (f">= {minimum:g}" if minimum is not None else "finite")
         value = self.raw(key, default, "number", rule)
         if value is None:
-            raise ScenarioError(f"{self._name(key)}: required number is missing")
+            raise ScenarioError(f"{self._name(key)}: required number is missing{self._misspelt(key)}")
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ScenarioError(f"{self._name(key)}: expected a finite number, got {value!r}")
         if positive and not value > 0:
@@ -70,7 +76,8 @@ class Fields:
     def text(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
         value = self.raw(key, default, "string", "" if choices is None else "one of " + ", ".join(choices))
         if not isinstance(value, str):
-            raise ScenarioError(f"{self._name(key)}: expected a string, got {value!r}")
+            missing = self._misspelt(key) if value is None else ""
+            raise ScenarioError(f"{self._name(key)}: expected a string, got {value!r}{missing}")
         if choices is not None and value not in choices:
             raise ScenarioError(f"{self._name(key)}: unknown value {value!r}; known: {', '.join(choices)}")
         return value
@@ -106,4 +113,7 @@ class Fields:
     def done(self) -> None:
         unknown = sorted(set(self.data) - self.used)
         if unknown:
-            raise ScenarioError(f"{self._name(unknown[0])}: unknown field; known here: {', '.join(sorted(self.used))}")
+            near = difflib.get_close_matches(unknown[0], sorted(self.used), n=1)
+            raise ScenarioError(f"{self._name(unknown[0])}: unknown field" + (f" (did you mean {near[0]!r}?)" if near
+                                                                                else "")
+                                + f"; known here: {', '.join(sorted(self.used))}")

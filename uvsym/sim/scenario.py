@@ -7,6 +7,7 @@ The shipped examples (``uvsym simulate --list``) document every field.
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass
@@ -103,6 +104,11 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
     top.describe("name", "string", "", "the file's name")
     name = top.text("name", default_name)
     description = top.text("description", "")
+    if "vehicle" not in data:
+        near = difflib.get_close_matches("study", [str(k) for k in data], n=1, cutoff=0.7)
+        raise ScenarioError("vehicle: missing; a vehicle scenario names its vehicle (vehicle = NAME, see uvsym "
+                            "models), a derivation's scenario its study (study = NAME)"
+                            + (f"; is {near[0]!r} a misspelt 'study'?" if near else ""))
     vehicle_name = top.text("vehicle")
     overrides = top.raw("vehicle_parameters", {}, "table", "parameter = value overrides (uvsym models show VEHICLE)")
     if not isinstance(overrides, dict):

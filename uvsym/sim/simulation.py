@@ -101,6 +101,8 @@ def _attitude_guard(loop):
     previous = [None]
 
     def guard(t: np.ndarray, out: np.ndarray) -> None:
+        if not len(out):
+            return  # no sample to judge (a run stopped before its first one is reported by the runner)
         cos_theta = np.cos(out[:, column])
         before = np.concatenate([[cos_theta[0] if previous[0] is None else previous[0]], cos_theta[:-1]])
         hit = np.flatnonzero((np.abs(cos_theta) < 1e-9) | (np.sign(cos_theta) != np.sign(before)))

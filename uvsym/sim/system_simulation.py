@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
@@ -57,6 +58,11 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     and, with substitutions, substitution (each channel's switch, 0 or 1).
     """
     N = grid(duration, dt)
+    for what, faults in (("actuator_faults", actuator_faults), ("sensor_faults", sensor_faults)):
+        late = [i for i, f in enumerate(faults) if not f.profile.onset < duration]
+        if late:
+            raise SimulationError(f"{what}[{late[0]}]: onset {faults[late[0]].profile.onset:g} s is not before the "
+                                  f"end of the run ({duration:g} s): the fault would never act")
     loop = interconnect(plant, blocks, dt=dt, actuator_faults=tuple(actuator_faults),
                         sensor_faults=tuple(sensor_faults), substitutions=substitutions, substeps=substeps, p=p)
     check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
