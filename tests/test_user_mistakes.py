@@ -36,7 +36,7 @@ def test_misspelt_fields_are_pointed_at():
         parse_scenario({"studdy": "sensor-fdi-lms"})
     data = _docking()
     data["controller"]["path"]["lookahed"] = 5.0
-    with pytest.raises(ScenarioError, match=r"controller\.path\.lookahed: unknown field \(did you mean 'lookahead'\?\)"):
+    with pytest.raises(ScenarioError, match=r"path\.lookahed: unknown field \(did you mean 'lookahead'\?\)"):
         parse_scenario(data)
 
 
