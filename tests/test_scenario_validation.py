@@ -36,7 +36,7 @@ def _with(table, **changes):
     ({"controller__path__waypoints__1__0": math.nan}, r"controller\.path\.waypoints\[1\]\[0\]: expected a finite"),
     ({"controller__path__waypoints__2__1": "east"}, r"controller\.path\.waypoints\[2\]\[1\]: .*'east'"),
     ({"faults__0__onset": 120.0}, r"faults\[0\]\.onset: 120 s is outside the run \[0, 90\) s"),
-    ({"faults__0__onset": -1.0}, r"faults\[0\]: fault profile onset must be a finite time >= 0 s"),
+    ({"faults__0__onset": -1.0}, r"faults\[0\]\.onset: must be >= 0.0, got -1.0"),
     ({"faults__1__value": -5.0}, r"faults\[1\]\.value: a proportional factor .* -5 would reverse it"),
     ({"faults__1__value": 1.0}, r"faults\[1\]\.value: 1 is the healthy value of a proportional fault"),
     ({"faults__0__value": 0.0}, r"faults\[0\]\.value: 0 is the healthy value of a bias fault"),

@@ -212,9 +212,11 @@ def _profile(fields: _Fields) -> Profile:
     defaults = Profile()
     kwargs = {"kind": fields.text("profile", "step", choices=PROFILES)}
     fields.describe("end", "number", "> onset, s: the fault stops (faults that come and go)", "none")
+    fields.describe("duty", "number", "in (0, 1]: the fraction of each period the fault is on", "0.5")
     for key in _PROFILE_KEYS[1:]:
         if key != "end" or fields.has(key):
-            kwargs[key] = fields.number(key, getattr(defaults, key))
+            kwargs[key] = fields.number(key, getattr(defaults, key), positive=key in ("duration", "rate", "period"),
+                                        minimum=0.0 if key == "onset" else None)
     return Profile(**kwargs)
 
 
