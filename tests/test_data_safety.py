@@ -113,3 +113,94 @@ def test_quick_look_figures_make_their_folder_and_type_their_errors(tmp_path):
     (tmp_path / "afile").write_text("x")
     with pytest.raises(PathError, match="afile is a file, not a folder"):
         result.plot(tmp_path / "afile" / "run.svg")
+
+
+def test_simulate_keeps_an_existing_figure_and_refuses_a_folder_before_the_run(tmp_path, capsys):
+    mine = tmp_path / "mine.svg"
+    mine.write_text("<svg>mine</svg>")
+    assert main(["simulate", "docking_faults", "--plot", str(mine)]) == 2
+    captured = capsys.readouterr()
+    assert "mine.svg exists; refusing to overwrite" in captured.err and "final state" not in captured.out
+    assert mine.read_text() == "<svg>mine</svg>"
+    beside = tmp_path / "new.svg"  # the figure --out new.npz --plot writes
+    beside.write_text("<svg>beside</svg>")
+    assert main(["simulate", "docking_faults", "--out", str(tmp_path / "new.npz"), "--plot"]) == 2
+    assert "new.svg exists; refusing to overwrite" in capsys.readouterr().err
+    assert beside.read_text() == "<svg>beside</svg>" and not (tmp_path / "new.npz").exists()
+    folder = tmp_path / "u"
+    folder.mkdir()
+    assert main(["simulate", "docking_faults", "--plot", str(folder)]) == 2
+    captured = capsys.readouterr()
+    assert f"cannot write the figure to {folder}: it is a folder" in captured.err and "final state" not in captured.out
+    assert not (tmp_path / "u.png").exists() and not list(folder.iterdir())
+    assert main(["simulate", "docking_faults", "--plot", str(mine), "--force"]) == 0
+    assert f"wrote {mine}\n" in capsys.readouterr().out and mine.read_text().startswith("<?xml")  # asked for
+
+
+def _package_with(folder, name: str, functions: dict):
+    """A uvsym package of ``functions`` (name -> expression of x) written into ``folder``."""
+    import casadi as ca
+
+    from uvsym.codegen.package import Exported, write_package
+
+    x = ca.SX.sym("x")
+    exported = [Exported(ca.Function(f, [x], [expr(x)], ["x"], ["y"]), ("x (-)",), ("y (-)",), f)
+                for f, expr in functions.items()]
+    return write_package(folder, exported, name)
+
+
+def test_an_edited_or_added_file_in_uvsyms_own_package_is_refused_and_named(tmp_path):
+    out = tmp_path / "c"
+    manifest = _package_with(out, "pkg", {"double": lambda x: 2 * x})
+    assert manifest["files"]["main.c"] and "manifest.json" not in manifest["files"]
+    assert claim_folder(out, "the C package", "package") == out  # untouched: uvsym's own
+    (out / "main.c").write_text("int main(void) { return 42; }\n")
+    (out / "notes.txt").write_text("keep")
+    with pytest.raises(PathError, match=r"c holds files uvsym did not write \(notes.txt\) and files changed "
+                                        r"since uvsym wrote them \(main.c\).*--force"):
+        claim_folder(out, "the C package", "package")
+    assert claim_folder(out, "the C package", "package", force=True) == out
+    legacy = json.loads((out / "manifest.json").read_text())
+    del legacy["files"]  # written by an older uvsym: recognised by its manifest as before
+    (out / "manifest.json").write_text(json.dumps(legacy))
+    assert claim_folder(out, "the C package", "package") == out
+
+
+def test_codegen_refuses_its_own_package_once_a_user_edited_it(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert main(["codegen", "motor-luenberger", "-o", str(out)]) == 0
+    (out / "main.c").write_text("int main(void) { return 42; }\n")
+    assert main(["codegen", "motor-luenberger", "-o", str(out)]) == 2
+    assert "files changed since uvsym wrote them (main.c)" in capsys.readouterr().err
+    assert (out / "main.c").read_text() == "int main(void) { return 42; }\n"
+
+
+def test_a_package_written_over_another_removes_only_the_old_packages_files(tmp_path):
+    out = tmp_path / "c"
+    _package_with(out, "old", {"double": lambda x: 2 * x})
+    (out / "src" / "notes.txt").write_text("mine")  # forced in: not the old package's
+    manifest = _package_with(out, "new", {"halve": lambda x: x / 2})
+    assert not list(out.rglob("old*"))  # src/old.c, src/old_casadi.c, include/old*.h
+    assert (out / "src" / "notes.txt").read_text() == "mine"
+    files = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
+    assert files == set(manifest["files"]) | {"manifest.json", "src/notes.txt"}
+
+
+def test_a_report_folder_is_checked_against_its_stamp(tmp_path, capsys):
+    import shutil
+    from pathlib import Path
+
+    fresh = tmp_path / "models"  # a committed report in a fresh clone: no .build.json
+    shutil.copytree(Path(__file__).parent.parent / "reports" / "models", fresh,
+                    ignore=shutil.ignore_patterns(".build.json"))
+    for _ in range(2):  # the first run by today's rule, the second by the stamp of the first
+        assert main(["report", "models", "--out", str(tmp_path)]) == 0
+    stamp = json.loads((fresh / ".build.json").read_text())
+    assert stamp["source_fingerprint"] and "report.md" in stamp["files"] and ".build.json" not in stamp["files"]
+    (fresh / "notes.txt").write_text("keep")
+    (fresh / "report.md").write_text("# edited by hand\n")
+    assert main(["report", "models", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert ("models holds files uvsym did not write (notes.txt) and files changed since uvsym wrote them "
+            "(report.md)") in err
+    assert (fresh / "report.md").read_text() == "# edited by hand\n" and (fresh / "notes.txt").read_text() == "keep"

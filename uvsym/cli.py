@@ -24,7 +24,7 @@ from uvsym.derivation import (
 )
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
-from uvsym.paths import claim_folder, make_folder, output_folder
+from uvsym.paths import claim_folder, file_hashes, make_folder, output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["BUILD_STAMP", "main"]
@@ -131,8 +131,9 @@ def _cmd_report(args) -> int:
         study.build(out_dir, progress)
         progress("report.html")
         write_html(out_dir)
-        (out_dir / BUILD_STAMP).write_text(json.dumps({"derivation": study.name,
-                                                       "source_fingerprint": source_fingerprint(study)}) + "\n")
+        stamp = {"derivation": study.name, "source_fingerprint": source_fingerprint(study),
+                 "files": file_hashes(out_dir, skip=BUILD_STAMP)}  # what claim_folder checks next time
+        (out_dir / BUILD_STAMP).write_text(json.dumps(stamp) + "\n")
         print(f"wrote {out_dir}")
     return 0
 
@@ -194,17 +195,20 @@ def _cmd_simulate(args) -> int:
     if args.out:  # format, folder and an existing file checked before the run
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
-    if "study" in table:
+    scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
+    figure = None
+    if args.plot is not None:  # the figure checked like the result, before the run
+        default = Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name if scenario else path.stem}.svg"
+        figure = SimResult.check_plot_path(args.plot or default, overwrite=args.force)
+    if scenario is None:
         table = dict(table)
         result = _simulate_study(table.pop("study"), table, path.stem, args.method)
-        name = path.stem
     else:
-        scenario = parse_scenario(table, default_name=path.stem)
         method = args.method or "fast"
         bar = ProgressBar(f"{scenario.name} ({method})")
         result = simulate_scenario(scenario, method=method, progress=bar)
         bar.close()
-        wall, name = result.meta["wall_s"], scenario.name
+        wall = result.meta["wall_s"]
         print(f"{scenario.name}: {scenario.model.name}, {scenario.duration:g} s at {scenario.step:g} s, method "
               f"{method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
               f"build {result.meta['build_s']:.2f} s")
@@ -212,9 +216,8 @@ def _cmd_simulate(args) -> int:
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
-    if args.plot is not None:
-        figure = Path(args.plot or (Path(args.out).with_suffix(".svg") if args.out else f"{name}.svg"))
-        result.plot(figure)
+    if figure is not None:
+        result.plot(figure, overwrite=args.force)
         print(f"wrote {figure}")
     return 0
 

@@ -1,21 +1,25 @@
 """Output folders and files: checked before anything is written into them.
 
-A folder uvsym writes a package or a report into must be new, empty, or recognisably uvsym's own
-(its manifest: a C package's ``manifest.json``, a report's ``report.md`` with ``results.json``);
-otherwise the files in it are someone else's and are not overwritten unless ``force``. An
-existing result file is not overwritten unless ``overwrite``. Every refusal is a
-:class:`~uvsym.errors.PathError` naming the path.
+A folder uvsym writes a package or a report into must be new, empty, or uvsym's own: its record
+(:data:`RECORDS`: a C package's ``manifest.json``, a report's ``.build.json``) lists the SHA-256 of
+every file uvsym wrote there (``files``), and a folder holding any other file, or a listed file
+changed since, is refused unless ``force``. A record without ``files`` (older uvsym; committed
+reports have no ``.build.json``) is recognised as before: an uvsym manifest, or ``report.md``
+beside ``results.json``. An existing result file is not overwritten unless ``overwrite``. Every
+refusal is a :class:`~uvsym.errors.PathError` naming the path.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from pathlib import Path
 
 from uvsym.errors import PathError, UvsymError
 
-__all__ = ["output_folder", "claim_folder", "make_folder", "output_file", "OWNERS"]
+__all__ = ["output_folder", "claim_folder", "make_folder", "output_file", "OWNERS", "RECORDS", "file_hashes",
+           "recorded_files", "write_files", "remove_stale"]
 
 
 def output_folder(path, what: str, error: type[UvsymError] = UvsymError) -> Path:
@@ -47,20 +51,85 @@ def _report(folder: Path) -> bool:
         return False
 
 
-# what uvsym writes -> how it recognises a folder of its own
+# what uvsym writes -> how it recognises a folder of its own without a list of files
 OWNERS = {"package": _package_manifest, "report": _report}
+# what uvsym writes -> its record in the folder (a JSON object whose "files" maps path -> SHA-256)
+RECORDS = {"package": "manifest.json", "report": ".build.json"}
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def file_hashes(folder, skip: str | None = None) -> dict[str, str]:
+    """Every file under ``folder`` (its path relative to it, with /) -> SHA-256, except ``skip``."""
+    folder = Path(folder)
+    return {rel: _sha256(p) for p in sorted(folder.rglob("*"))
+            if p.is_file() and (rel := p.relative_to(folder).as_posix()) != skip}
+
+
+def recorded_files(folder, owner: str) -> dict[str, str] | None:
+    """The files ``folder``'s ``owner`` record lists (path -> SHA-256); None when it lists none."""
+    try:
+        record = json.loads((Path(folder) / RECORDS[owner]).read_text())
+    except (OSError, ValueError):
+        return None
+    files = record.get("files") if isinstance(record, dict) else None
+    if not isinstance(files, dict) or not all(isinstance(h, str) for h in files.values()):
+        return None
+    return files
+
+
+def write_files(folder, texts: dict[str, str]) -> dict[str, str]:
+    """Write ``texts`` (path relative to ``folder`` -> content; folders made); their SHA-256 by path."""
+    folder = Path(folder)
+    for rel, text in texts.items():
+        (folder / rel).parent.mkdir(parents=True, exist_ok=True)
+        (folder / rel).write_text(text)
+    return {rel: _sha256(folder / rel) for rel in texts}
+
+
+def remove_stale(folder, old: dict[str, str], kept) -> list[str]:
+    """Remove the files of the ``old`` record not in ``kept`` and unchanged since (uvsym's own), and
+    the folders they leave empty; the paths removed."""
+    folder, removed = Path(folder), []
+    for rel, digest in sorted(old.items()):
+        path = folder / rel
+        if rel in kept or ".." in Path(rel).parts or not path.is_file() or _sha256(path) != digest:
+            continue
+        path.unlink()
+        removed.append(rel)
+        for parent in path.parents:
+            if parent == folder or not parent.is_relative_to(folder) or any(parent.iterdir()):
+                break
+            parent.rmdir()
+    return removed
+
+
+def _listing(names: list[str]) -> str:
+    return ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
 
 
 def claim_folder(path, what: str, owner: str, force: bool = False) -> Path:
-    """The folder ``path`` for ``what`` (not made here); PathError when it holds files that are not
-    uvsym's own ``owner`` output (see :data:`OWNERS`), unless ``force``, or is not a writable folder."""
+    """The folder ``path`` for ``what`` (not made here); PathError naming the files when it holds
+    files that are not uvsym's own ``owner`` output, or that changed since uvsym wrote them (module
+    docstring), unless ``force``, or is not a writable folder."""
     folder = output_folder(path, what, PathError)
-    if folder.is_dir() and not force and not OWNERS[owner](folder):
-        others = sorted(p.name for p in folder.iterdir())
-        if others:
-            shown = ", ".join(others[:5]) + (f" and {len(others) - 5} more" if len(others) > 5 else "")
-            raise PathError(f"{folder} holds files uvsym did not write ({shown}); refusing to write {what} over "
-                            "them: choose a new or empty folder, or pass --force to overwrite")
+    if not folder.is_dir() or force:
+        return folder
+    files = recorded_files(folder, owner)
+    if files is None:  # no list of files: today's rule
+        others = [] if OWNERS[owner](folder) else sorted(p.name for p in folder.iterdir())
+        changed = []
+    else:
+        present = file_hashes(folder, skip=RECORDS[owner])
+        others = [rel for rel in present if rel not in files]
+        changed = [rel for rel, digest in present.items() if rel in files and files[rel] != digest]
+    problems = ([f"files uvsym did not write ({_listing(others)})"] if others else []) + (
+        [f"files changed since uvsym wrote them ({_listing(changed)})"] if changed else [])
+    if problems:
+        raise PathError(f"{folder} holds {' and '.join(problems)}; refusing to write {what} over them: "
+                        "choose a new or empty folder, or pass --force to overwrite")
     return folder
 
 

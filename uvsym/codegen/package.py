@@ -15,7 +15,11 @@
     README.md                                      API, sizes and units, build, threads, codes
     manifest.json                                  functions, arguments with sizes and a unit
                                                    per entry, precision, citation, SHA-256 of
-                                                   each serialised Function
+                                                   each serialised Function and of each file
+                                                   written (``files``, see uvsym.paths)
+
+Files an earlier package in ``out_dir`` listed in its manifest and this one does not write are
+removed when unchanged (:func:`uvsym.paths.remove_stale`); nothing else there is touched.
 
 Every external C name starts with the package name (CasADi's internals with ``<name>_casadi__``,
 the real type is ``<name>_real``, macros with ``<NAME>_``), so that packages link into one
@@ -47,7 +51,7 @@ from uvsym.codegen.example import Example
 from uvsym.codegen.programs import example_program, harness_program
 from uvsym.codegen.readme import package_readme
 from uvsym.errors import CodegenError
-from uvsym.paths import output_folder
+from uvsym.paths import output_folder, recorded_files, remove_stale, write_files
 
 __all__ = ["ERROR_CODES", "Exported", "PRECISIONS", "casadi_name", "write_package"]
 
@@ -214,8 +218,7 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
             raise CodegenError(f"package {name}: the example calls {example.function}, not one of {', '.join(names)}")
         example.check_against(functions[names.index(example.function)].function)
     out = output_folder(out_dir, "the package", CodegenError)
-    (out / "include").mkdir(parents=True, exist_ok=True)
-    (out / "src").mkdir(exist_ok=True)
+    previous = recorded_files(out, "package") or {}
     # CasADi's internal symbols get the prefix <name>_casadi__, so they cannot meet an API name
     generator = ca.CodeGenerator(f"{name}_casadi", {"with_header": True, "casadi_real": precision,
                                                     "prefix": f"{name}_casadi_"})
@@ -225,18 +228,15 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
         generator.generate(f"{scratch}{os.sep}")
         source = _silence_unused((Path(scratch) / f"{name}_casadi.c").read_text())
         header = (Path(scratch) / f"{name}_casadi.h").read_text()
-    (out / "src" / f"{name}_casadi.c").write_text(source)
-    (out / "include" / f"{name}_casadi.h").write_text(header)
     wrappers = [_wrapper(e, name, finite_check) for e in functions]
-    (out / "include" / f"{name}.h").write_text(_header(name, description, citation, precision, wrappers))
     checked = finite_check and any(d for e in functions for _, _, d, _ in e.arguments())  # an entry to check
     all_finite = _ALL_FINITE.format(package=name) + "\n" if checked else ""
     includes = f'#include <math.h>\n#include "{name}_casadi.h"\n#include "{name}.h"\n\n'
-    (out / "src" / f"{name}.c").write_text(includes + all_finite + "\n".join(b for _, b in wrappers))
-    (out / "main.c").write_text(example_program(functions, name, example))
-    (out / "harness.c").write_text(harness_program(functions, name))
-    (out / "Makefile").write_text(makefile(name))
-    (out / "CMakeLists.txt").write_text(cmake_lists(name))
+    texts = {f"src/{name}_casadi.c": source, f"include/{name}_casadi.h": header,
+             f"include/{name}.h": _header(name, description, citation, precision, wrappers),
+             f"src/{name}.c": includes + all_finite + "\n".join(b for _, b in wrappers),
+             "main.c": example_program(functions, name, example), "harness.c": harness_program(functions, name),
+             "Makefile": makefile(name), "CMakeLists.txt": cmake_lists(name)}
     manifest = {
         "package": name, "description": description, "citation": citation, "precision": precision,
         "casadi": ca.__version__, "finite_check": finite_check,
@@ -252,6 +252,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
             "sha256": hashlib.sha256(e.function.serialize().encode()).hexdigest(),
         } for e in functions],
     } | (extra or {})
-    (out / "README.md").write_text(package_readme(manifest))
+    texts["README.md"] = package_readme(manifest)
+    manifest["files"] = write_files(out, texts)
+    remove_stale(out, previous, manifest["files"])
     (out / "manifest.json").write_text(json.dumps(manifest, indent=2, sort_keys=True) + "\n")
     return manifest

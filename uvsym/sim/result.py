@@ -20,11 +20,12 @@ import numpy as np
 import scipy.io
 
 from uvsym.errors import FileFormatError, PathError, SimulationError, UnknownNameError
-from uvsym.paths import make_folder, output_file
+from uvsym.paths import output_file
 
-__all__ = ["Signal", "SimResult", "FORMATS"]
+__all__ = ["Signal", "SimResult", "FORMATS", "FIGURE_FORMATS"]
 
 FORMATS = (".npz", ".csv", ".mat")
+FIGURE_FORMATS = (".svg", ".png", ".pdf")
 _CONTROL = re.compile(r"[\x00-\x1f\x7f\ud800-\udfff]")  # control characters, lone surrogates
 
 
@@ -99,6 +100,16 @@ class SimResult:
         _suffix(path)
         return output_file(path, "the result", overwrite)
 
+    @staticmethod
+    def check_plot_path(path, overwrite: bool = False) -> Path:
+        """``path`` checked before a run plots to it: a figure suffix (.svg, .png or .pdf), not a
+        folder, its folder made if missing, no existing file unless ``overwrite`` (PathError)."""
+        path = Path(path)
+        if path.suffix not in FIGURE_FORMATS and not path.is_dir():
+            raise PathError(f"cannot write the figure to {path}: give it one of the suffixes "
+                            f"{', '.join(FIGURE_FORMATS)}")
+        return output_file(path, "the figure", overwrite)
+
     def save(self, path, overwrite: bool = False) -> Path:
         """Write to ``path`` (its folder is made if missing); the suffix (.npz, .csv or .mat) picks the
         format. An existing file is kept (PathError) unless ``overwrite``."""
@@ -135,12 +146,14 @@ class SimResult:
                 NotImplementedError, scipy.io.matlab.MatReadError, SimulationError) as exc:
             raise FileFormatError(f"{path} is not a result file uvsym wrote ({type(exc).__name__}: {exc})") from None
 
-    def plot(self, path=None, names: tuple[str, ...] | None = None):
+    def plot(self, path=None, names: tuple[str, ...] | None = None, overwrite: bool = False):
         """Quick-look figure: one panel per signal and unit (angles in degrees); saved if ``path``
-        (its folder made if missing; PathError when it cannot be written).
+        (checked by :meth:`check_plot_path`: an existing file is kept unless ``overwrite``).
 
         Default signals: states, commands and fault estimates of a scenario run; states, inputs
         and every block's published signals of a wired loop."""
+        if path is not None:
+            path = self.check_plot_path(path, overwrite)
         import matplotlib
 
         matplotlib.use("Agg")
@@ -171,8 +184,6 @@ class SimResult:
         if path is not None:
             from uvsym.report.figures import save_svg
 
-            path = Path(path)
-            make_folder(path.parent, "the figure")
             try:
                 if path.suffix == ".svg":
                     save_svg(fig, path)
@@ -181,8 +192,6 @@ class SimResult:
                     plt.close(fig)
             except OSError as exc:
                 raise PathError(f"cannot write the figure to {path}: {exc.strerror or exc}") from None
-            except ValueError as exc:  # matplotlib: a format it does not know
-                raise PathError(f"cannot write the figure to {path}: {exc}") from None
         return fig
 
 
