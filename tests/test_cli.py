@@ -62,16 +62,20 @@ def test_unknown_names_exit_2_with_a_message(args):
 
 
 def test_report_models_is_deterministic(tmp_path, built_report):
+    import hashlib
+
+    from uvsym.derivation import derivation, source_fingerprint
+
     first = built_report("models")
     assert main(["report", "models", "--out", str(tmp_path)]) == 0
     names = sorted(p.name for p in first.iterdir())
     assert names == [".build.json", "report.html", "report.md", "results.json", "step_responses.svg"]
     for name in names:
         assert (first / name).read_bytes() == (tmp_path / "models" / name).read_bytes(), name
-    from uvsym.derivation import derivation, source_fingerprint
-
     stamp = json.loads((tmp_path / "models" / ".build.json").read_text())
-    assert stamp == {"derivation": "models", "source_fingerprint": source_fingerprint(derivation("models"))}
+    assert stamp["derivation"] == "models" and stamp["source_fingerprint"] == source_fingerprint(derivation("models"))
+    assert sorted(stamp["files"]) == [n for n in names if n != ".build.json"]
+    assert stamp["files"]["report.md"] == hashlib.sha256((first / "report.md").read_bytes()).hexdigest()
 
 
 def test_models_report_checks_the_reference_cases(built_report):

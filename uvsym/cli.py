@@ -24,12 +24,12 @@ from uvsym.derivation import (
 )
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
-from uvsym.paths import claim_folder, file_hashes, make_folder, output_folder
+from uvsym.paths import RECORDS, claim_folder, file_hashes, make_folder, output_folder
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["BUILD_STAMP", "main"]
 
-BUILD_STAMP = ".build.json"  # in each report folder: the source fingerprint it was built from (not committed)
+BUILD_STAMP = RECORDS["report"]  # in each report folder: its source fingerprint and files (not committed)
 
 
 def _table(rows: list[list[str]], header: list[str]) -> str:
@@ -355,7 +355,7 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
     simulate.add_argument("--schema", action="store_true", help="print every field of a vehicle scenario file "
                                                                 "(type, default, rule) as a Markdown table")
-    simulate.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+    simulate.add_argument("--force", action="store_true", help="overwrite an existing --out or --plot file")
     simulate.set_defaults(run=_cmd_simulate)
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "
                                              "a set's own options as --name value (uvsym codegen --list)")
