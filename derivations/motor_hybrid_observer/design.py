@@ -104,8 +104,7 @@ def design(printed_typo: bool = False) -> Design:
 
 def _require_equilibrium(plant: System, lin: Linearization) -> None:
     """VerificationError naming the states that move at the operating point (relative to their terms)."""
-    scale = 1.0 + np.abs(lin.A) @ np.abs(lin.x0) + np.abs(lin.B) @ np.abs(lin.u0)
-    moving = [n for n, f, s in zip(plant.x.names, lin.f0, scale) if abs(f) > 1e-9 * s]
+    moving = [n for n, m in zip(plant.x.names, lin.moving()) if m]
     if moving:
         raise VerificationError(f"{plant.name}: the operating point is not an equilibrium of the model "
                                              f"({', '.join(moving)} move); the linearisation would not describe a "

@@ -48,6 +48,13 @@ class Linearization:
     y0: np.ndarray
     dt: float | None = None
 
+    def moving(self, tolerance: float = 1e-9) -> np.ndarray:
+        """(n_x,) bool: the states that do not stay at ``x0`` (``f0`` beyond 0, or beyond ``x0`` in
+        discrete time, by more than ``tolerance`` times the size of their linear terms)."""
+        rest = self.x0 if self.dt is not None else np.zeros_like(self.f0)
+        scale = 1.0 + np.abs(self.A) @ np.abs(self.x0) + np.abs(self.B) @ np.abs(self.u0)
+        return np.abs(self.f0 - rest) > tolerance * scale
+
 
 @dataclass(frozen=True)
 class System:

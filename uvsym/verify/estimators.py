@@ -73,9 +73,7 @@ def _point(plant, x0, u0) -> tuple[np.ndarray, np.ndarray, str]:
     x0 = plant.x.vector(plant.x_op if x0 is None else x0, "x0")
     u0 = plant.u.vector(plant.u_op if u0 is None else u0, "u0")
     lin = plant.linearize(x0, u0)
-    rest = lin.x0 if plant.discrete else np.zeros(plant.x.size)
-    scale = 1.0 + np.abs(lin.A) @ np.abs(x0) + np.abs(lin.B) @ np.abs(u0)
-    moving = [n for n, f, r, s in zip(plant.x.names, lin.f0, rest, scale) if abs(f - r) > EQUILIBRIUM_TOLERANCE * s]
+    moving = [n for n, m in zip(plant.x.names, lin.moving(EQUILIBRIUM_TOLERANCE)) if m]
     if moving:
         raise VerificationError(f"{plant.name}: the point is not an equilibrium ({', '.join(moving)} move): the true "
                                 "state would not stay there")
