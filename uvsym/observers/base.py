@@ -127,20 +127,28 @@ class Observer:
                                 f" expected {self.state.size} finite")
         return s0
 
-    def run(self, Y, U, p=None, s0=None) -> tuple[np.ndarray, np.ndarray]:
-        """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out))."""
+    def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out)).
+
+        missing_y: Y may hold NaN (an estimator that skips the update of such a sample, e.g. a
+        Kalman filter); the initial state is then taken from the first complete measurement.
+        """
         Y, U = np.atleast_2d(np.asarray(Y, dtype=float)), np.atleast_2d(np.asarray(U, dtype=float))
-        if Y.shape[1] != self.reads_y.size or U.shape[1] != self.reads_u.size or len(Y) != len(U):
-            raise ObserverError(f"{self.name}: Y must be (N, {self.reads_y.size}) and U (N, {self.reads_u.size}), "
-                                f"got {Y.shape} and {U.shape}")
-        if len(Y) == 0 or not (np.all(np.isfinite(Y)) and np.all(np.isfinite(U))):
-            raise ObserverError(f"{self.name}: Y and U need at least one sample and finite values")
+        if Y.shape[1] != self.reads_y.size or U.shape[1] != self.reads_u.size or len(Y) != len(U) or len(Y) == 0:
+            raise ObserverError(f"{self.name}: measurements Y must be (N, {self.reads_y.size}) "
+                                f"({', '.join(self.reads_y.names)}) and inputs U (N, {self.reads_u.size}), "
+                                f"at least one sample; got {Y.shape} and {U.shape}")
+        bad_y = np.any(np.isinf(Y)) if missing_y else not np.all(np.isfinite(Y))
+        if bad_y or not np.all(np.isfinite(U)):
+            raise ObserverError(f"{self.name}: inputs U must be finite and measurements Y finite"
+                                + (" or NaN" if missing_y else ""))
         p = self.parameters(p)
-        s = self.initial_state(Y[0], U[0], p) if s0 is None else np.asarray(s0, dtype=float).reshape(-1)
+        first = next((k for k in range(len(Y)) if np.all(np.isfinite(Y[k]))), 0)
+        s = self.initial_state(np.nan_to_num(Y[first]), U[0], p) if s0 is None else \
+            np.asarray(s0, dtype=float).reshape(-1)
         if s.size != self.state.size or not np.all(np.isfinite(s)):
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
-        roll = self.step.mapaccum("run", len(Y), [0], [0])
-        S, OUT = roll(s, Y.T, U.T, p)
+        S, OUT = self.step.mapaccum("run", len(Y), [0], [0])(s, Y.T, U.T, p)
         return np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
 
 

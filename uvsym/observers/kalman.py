@@ -258,20 +258,7 @@ def run_filter(obs: Observer, Y, U, p=None, s0=None) -> tuple[np.ndarray, np.nda
     ObserverError for wrong sizes or non-finite inputs; CovarianceError naming the first sample
     whose covariance was not positive definite.
     """
-    Y, U = np.atleast_2d(np.asarray(Y, dtype=float)), np.atleast_2d(np.asarray(U, dtype=float))
-    if Y.shape[1] != obs.reads_y.size or U.shape[1] != obs.reads_u.size or len(Y) != len(U) or len(Y) == 0:
-        raise ObserverError(f"{obs.name}: measurements Y must be (N, {obs.reads_y.size}) "
-                            f"({', '.join(obs.reads_y.names)}) and inputs U (N, {obs.reads_u.size}), N >= 1; "
-                            f"got {Y.shape} and {U.shape}")
-    if not np.all(np.isfinite(U)) or np.any(np.isinf(Y)):
-        raise ObserverError(f"{obs.name}: inputs U must be finite and measurements Y finite or NaN")
-    p = obs.parameters(p)
-    first = next((k for k in range(len(Y)) if np.all(np.isfinite(Y[k]))), 0)
-    s = obs.initial_state(np.nan_to_num(Y[first]), U[0], p) if s0 is None else np.asarray(s0, float).ravel()
-    if s.size != obs.state.size or not np.all(np.isfinite(s)):
-        raise ObserverError(f"{obs.name}: s0 must be {obs.state.size} finite values, got {s.size}")
-    S, OUT = obs.step.mapaccum("run", len(Y), [0], [0])(s, Y.T, U.T, p)
-    S, OUT = np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
+    S, OUT = obs.run(Y, U, p, s0, missing_y=True)
     margin = OUT[:, obs.publishes.index("pd_margin")]
     bad = np.flatnonzero(~(margin > 0.0))
     if bad.size:
