@@ -19,13 +19,13 @@ import numpy as np
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_luenberger.experiment import (
     CALIBRATION_SEEDS,
-    CONFIRM,
     FAULT_ONSET,
     INCIPIENT_RATE,
     INITIAL_OFFSET,
     NOISE,
     SENSOR_GAIN,
     THRESHOLD_FACTOR,
+    confirmed_alarm_time,
 )
 from uvsym.faults import Profile, SensorFault
 from uvsym.observers.hybrid import observer_state
@@ -107,9 +107,7 @@ def alarms(run_: dict, detector: str, threshold: float) -> np.ndarray:
 
 def detection_time(run_: dict, detector: str, threshold: float) -> float | None:
     """Time (s) of the first sample completing ``CONFIRM`` consecutive alarms, or None."""
-    above = alarms(run_, detector, threshold).astype(int)
-    hits = np.flatnonzero(np.convolve(above, np.ones(CONFIRM, dtype=int), mode="valid") == CONFIRM)
-    return float(run_["t"][hits[0] + CONFIRM - 1]) if hits.size else None
+    return confirmed_alarm_time(run_["t"], alarms(run_, detector, threshold))
 
 
 def run_cases() -> dict:

@@ -19,7 +19,7 @@ from derivations.motor_luenberger.design import design
 from uvsym.faults import Profile, SensorFault
 from uvsym.sim import observer_block, open_loop, simulate_system
 
-__all__ = ["CASES", "DURATION", "FAULT_ONSET", "detection_time", "run", "run_cases"]
+__all__ = ["CASES", "DURATION", "FAULT_ONSET", "confirmed_alarm_time", "detection_time", "run", "run_cases"]
 
 DURATION = 2.0  # s
 FAULT_ONSET = 1.0  # s
@@ -65,10 +65,14 @@ def _alarms(result, threshold: float) -> np.ndarray:
     return (np.abs(result[design().observer.name]["r_omega_m"]) > threshold) & (result.t >= CONVERGED_AFTER)
 
 
+def confirmed_alarm_time(t: np.ndarray, alarms: np.ndarray) -> float | None:
+    """Time (s) of the first sample that completes ``CONFIRM`` consecutive alarms (t, alarms: (N,)), or None."""
+    runs = np.convolve(np.asarray(alarms, dtype=int), np.ones(CONFIRM, dtype=int), mode="valid")
+    hits = np.flatnonzero(runs == CONFIRM)
+    return float(t[hits[0] + CONFIRM - 1]) if hits.size else None
+
+
 def detection_time(result, threshold: float) -> float | None:
     """Time (s) of the alarm: the first sample that completes ``CONFIRM`` consecutive samples with
     ``|r_omega_m| > threshold`` after the observer has converged, or None."""
-    above = _alarms(result, threshold).astype(int)
-    runs = np.convolve(above, np.ones(CONFIRM, dtype=int), mode="valid")
-    hits = np.flatnonzero(runs == CONFIRM)
-    return float(result.t[hits[0] + CONFIRM - 1]) if hits.size else None
+    return confirmed_alarm_time(result.t, _alarms(result, threshold))
