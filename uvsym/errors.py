@@ -136,3 +136,8 @@ class UIOConditionError(ObserverError):
 
 class PrecisionError(CodegenError):
     """A single-precision C build strays too far from double precision on its example data (names the figure)."""
+
+
+class DiagnosisError(ObserverError):
+    """A diagnosis setting is out of range or names an unknown observer, actuator, kind or channel
+    (the message names the field, e.g. ``diagnosis.window_s``)."""
