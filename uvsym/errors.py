@@ -28,6 +28,9 @@ __all__ = [
     "SetDivergenceError",
     "UIOConditionError",
     "StepSizeWarning",
+    "CampaignError",
+    "CampaignSizeError",
+    "ExecutorError",
 ]
 
 
@@ -141,3 +144,17 @@ class PrecisionError(CodegenError):
 class DiagnosisError(ObserverError):
     """A diagnosis setting is out of range or names an unknown observer, actuator, kind or channel
     (the message names the field, e.g. ``diagnosis.window_s``)."""
+
+
+class CampaignError(ScenarioError):
+    """A campaign file is invalid: a case, an axis, a draw or one of its runs' scenarios (names the
+    case and the field, e.g. ``case 'thruster': grid axis 'faults[0].onset'``)."""
+
+
+class CampaignSizeError(CampaignError):
+    """A campaign has more runs than its ``max_runs`` and was not confirmed (gives both figures)."""
+
+
+class ExecutorError(SimulationError):
+    """A campaign's executor cannot run: an unreachable scheduler (names the address) or a missing
+    optional dependency (names the extra to install)."""
