@@ -1,0 +1,201 @@
+"""Where a campaign's runs execute: local worker processes, or a Dask cluster.
+
+An executor's ``run(chunks, settings, on_chunk)`` executes every run of ``chunks`` (lists of
+:class:`~uvsym.campaign.spec.Run`) and calls ``on_chunk(index, rows)`` in the calling process as
+each chunk completes (its rows in the chunk's order). ``start()`` connects, before any run, and
+``close()`` releases the workers.
+
+:class:`LocalExecutor` hands one run at a time to each of its processes; a process that dies
+during a run gives that run an error row and is replaced, so the other runs go on.
+:class:`DaskExecutor` submits one task per chunk to the scheduler at ``scheduler`` (or to a
+``LocalCluster`` it starts when none is given); a chunk whose task fails (a worker killed) is
+resubmitted run by run, and a run that fails alone gets an error row.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections import deque
+from multiprocessing.connection import wait
+
+from uvsym.campaign import worker
+from uvsym.errors import ExecutorError
+
+__all__ = ["LocalExecutor", "DaskExecutor", "make_executor", "default_workers"]
+
+
+def default_workers() -> int:
+    """Local worker processes when none are asked for: the cores this process may use."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _context():
+    """forkserver where there is one (workers fork from a clean process that imported uvsym once), else spawn."""
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(["uvsym.campaign.worker", "uvsym.sim.simulation"])
+        return context
+    return multiprocessing.get_context("spawn")
+
+
+class LocalExecutor:
+    """``workers`` local processes (default: the cores)."""
+
+    def __init__(self, workers: int | None = None):
+        self.workers = workers or default_workers()
+        self._processes: list = []
+
+    def start(self) -> None:
+        """Nothing to connect to: processes start with the runs."""
+
+    def _spawn(self, settings):
+        parent, child = self._context.Pipe()
+        process = self._context.Process(target=worker.serve, args=(child, settings), daemon=True)
+        process.start()
+        child.close()
+        self._processes.append((process, parent))
+        return process, parent
+
+    def run(self, chunks, settings, on_chunk) -> None:
+        self._context = _context()
+        pending = deque((index, run) for index, chunk in enumerate(chunks) for run in chunk)
+        left = {index: len(chunk) for index, chunk in enumerate(chunks)}
+        rows: dict[int, dict] = {index: {} for index in left}
+        idle = [self._spawn(settings) for _ in range(min(self.workers, len(pending)))]
+        busy: dict = {}  # (process, conn) -> (chunk index, run)
+        lost = 0  # processes found dead while idle
+        try:
+            while pending or busy:
+                while idle and pending:
+                    slot, job = idle.pop(), pending.popleft()
+                    try:
+                        slot[1].send(job[1])
+                    except OSError:  # the idle process has gone: replace it, the run waits for the next
+                        lost += 1
+                        if lost > 2 * self.workers:
+                            raise ExecutorError(f"{lost} local worker processes ended before taking a run "
+                                                f"(last exit code {slot[0].exitcode})") from None
+                        pending.appendleft(job)
+                        self._processes.remove(slot)
+                        idle.append(self._spawn(settings))
+                        continue
+                    busy[slot] = job
+                ready = set(wait([s[1] for s in busy] + [s[0].sentinel for s in busy]))
+                for slot in [s for s in busy if s[1] in ready or s[0].sentinel in ready]:
+                    (process, conn), (index, run) = slot, busy.pop(slot)
+                    row = None
+                    try:
+                        if conn.poll():
+                            row = conn.recv()
+                    except (EOFError, OSError):
+                        pass
+                    if row is None:  # the process died during the run
+                        process.join(5.0)
+                        row = worker.failure_row(run, f"WorkerDied: the worker process ended (exit code "
+                                                      f"{process.exitcode}) during this run")
+                        conn.close()
+                        self._processes.remove(slot)
+                        if pending:
+                            idle.append(self._spawn(settings))
+                    else:
+                        idle.append(slot)
+                    rows[index][run.id] = row
+                    left[index] -= 1
+                    if not left[index]:
+                        on_chunk(index, [rows[index][r.id] for r in chunks[index]])
+                        del rows[index]
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        for _, conn in self._processes:
+            try:
+                conn.send(None)
+            except OSError:
+                pass
+        for process, conn in self._processes:
+            process.join(2.0)
+            if process.is_alive():
+                process.terminate()
+                process.join(2.0)
+            conn.close()
+        self._processes = []
+
+
+def _distributed():
+    try:
+        import distributed
+    except ImportError:
+        raise ExecutorError("the Dask executor needs dask.distributed: pip install 'uvsym[cluster]'") from None
+    return distributed
+
+
+class DaskExecutor:
+    """Chunks as tasks on the Dask scheduler at ``scheduler`` ('tcp://host:8786'), reached within
+    ``timeout_s`` s; without a scheduler, a LocalCluster of ``workers`` single-threaded processes."""
+
+    def __init__(self, scheduler: str | None = None, workers: int | None = None, timeout_s: float = 10.0):
+        self.scheduler, self.workers, self.timeout_s = scheduler, workers, timeout_s
+        self.client = self.cluster = None
+
+    def start(self) -> None:
+        """Connect (or start the LocalCluster); ExecutorError naming the address when it cannot be reached."""
+        distributed = _distributed()
+        if self.scheduler is None:
+            self.cluster = distributed.LocalCluster(n_workers=self.workers or default_workers(),
+                                                    threads_per_worker=1, processes=True, dashboard_address=None)
+            address = self.cluster.scheduler_address
+        else:
+            address = self.scheduler
+        try:
+            self.client = distributed.Client(address, timeout=self.timeout_s)
+        except (OSError, TimeoutError, ValueError) as exc:
+            self.close()
+            raise ExecutorError(f"cannot reach the Dask scheduler at {address} within {self.timeout_s:g} s: "
+                                f"{exc}") from None
+
+    def run(self, chunks, settings, on_chunk) -> None:
+        distributed = _distributed()
+        if self.client is None:
+            self.start()
+        futures = {self.client.submit(worker.run_chunk, chunk, settings, pure=False): (index, None)
+                   for index, chunk in enumerate(chunks)}
+        parts: dict[int, dict] = {}
+        queue = distributed.as_completed(list(futures))
+        for future in queue:
+            index, alone = futures.pop(future)
+            chunk = chunks[index]
+            try:
+                rows = future.result()
+            except Exception as exc:  # a worker died under the task, or the task could not run
+                if alone is None and len(chunk) > 1:
+                    parts[index] = {}
+                    for run in chunk:  # find the run at fault: each alone
+                        single = self.client.submit(worker.run_chunk, [run], settings, pure=False)
+                        futures[single] = (index, run)
+                        queue.add(single)
+                    continue
+                rows = [worker.failure_row(alone or chunk[0], f"{type(exc).__name__}: {exc}")]
+            if alone is None:
+                on_chunk(index, rows)
+                continue
+            parts[index][alone.id] = rows[0]
+            if len(parts[index]) == len(chunk):
+                on_chunk(index, [parts.pop(index)[run.id] for run in chunk])
+
+    def close(self) -> None:
+        for resource in (self.client, self.cluster):
+            if resource is not None:
+                resource.close()
+        self.client = self.cluster = None
+
+
+def make_executor(kind: str = "local", *, workers: int | None = None, scheduler: str | None = None,
+                  timeout_s: float = 10.0):
+    """The executor ``kind`` ("local" or "dask"; a scheduler address implies dask)."""
+    if scheduler is not None or kind == "dask":
+        return DaskExecutor(scheduler, workers, timeout_s)
+    if kind != "local":
+        raise ExecutorError(f"executor: unknown kind {kind!r}; known: local, dask")
+    return LocalExecutor(workers)

@@ -1,0 +1,108 @@
+"""Per-run metrics of a campaign: the truth from the scenario, the diagnosis from the event log.
+
+Events are dicts ``{"t": s, "event": "detected" | "isolated" | "identified" | "cleared" |
+"ambiguous" | "unexcited", "actuator": label or None, "kind": kind or None, "value": number or
+None}`` (for "ambiguous" the actuator is the candidates joined by "|").
+
+The run's fault is its earliest (actuator faults before sensor faults at equal onsets); its
+window runs from the onset to the first "cleared" event at or after its end (a fault without an
+end lasts the run). An alarm (detected, isolated, identified) outside the window, or in a run
+without a fault, is a false alarm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["ALARMS", "METRIC_COLUMNS", "truth", "event_metrics", "run_metrics"]
+
+ALARMS = ("detected", "isolated", "identified")
+# every generic column a run gets, with its type (the run's grid fields and the hook's columns follow)
+METRIC_COLUMNS = {
+    "run_id": "string", "case": "string", "draw": "int64", "status": "string", "error": "string",
+    "n_faults": "int64", "true_actuator": "string", "true_sensor": "string", "true_kind": "string",
+    "true_value": "float64", "onset_s": "float64", "end_s": "float64",
+    "events": "int64", "detected": "bool", "detection_delay_s": "float64", "isolated_actuator": "string", "isolated_kind": "string",
+    "isolation_delay_s": "float64", "identified_value": "float64", "size_error_rel": "float64",
+    "false_alarms": "int64", "ambiguous": "bool", "unexcited": "bool", "path_error_rms_m": "float64",
+    "wall_s": "float64",
+}
+
+
+def truth(scenario) -> dict:
+    """n_faults and the run's fault: true_actuator or true_sensor (label), true_kind, true_value,
+    onset_s and end_s (None when it lasts the run); None throughout without a fault."""
+    model = scenario.model
+    faults = [(f.profile.onset, 0, i, model.input_labels[f.actuator], None, f)
+              for i, f in enumerate(scenario.actuator_faults)]
+    faults += [(f.profile.onset, 1, i, None, model.state_labels[f.channel], f)
+               for i, f in enumerate(scenario.sensor_faults)]
+    row = {"n_faults": len(faults), "true_actuator": None, "true_sensor": None, "true_kind": None,
+           "true_value": None, "onset_s": None, "end_s": None}
+    if faults:
+        onset, _, _, actuator, sensor, fault = min(faults, key=lambda f: f[:3])
+        end = fault.profile.end
+        row |= {"true_actuator": actuator, "true_sensor": sensor, "true_kind": fault.kind,
+                "true_value": float(fault.value), "onset_s": float(onset),
+                "end_s": None if math.isinf(end) else float(end)}
+    return row
+
+
+def event_metrics(true: dict, events: list[dict]) -> dict:
+    """Diagnosis metrics of one run from its events and :func:`truth`'s row.
+
+    detected / detection_delay_s: a "detected" event in the fault's window, the first one's time
+    after the onset (s); isolated_actuator / isolated_kind: the last "isolated" decision not
+    cleared by the end of the run (a "cleared" naming no actuator, or that one, clears it);
+    isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
+    identified_value: the last "identified" value in the window for it (or naming none);
+    size_error_rel: |identified - true| / |true| (None when true is 0); false_alarms: alarms
+    outside the window (module docstring); ambiguous, unexcited: any such event; events: how many.
+    """
+    events = sorted(events, key=lambda e: e["t"])
+    target = true["true_actuator"] or true["true_sensor"]
+    onset = true["onset_s"]
+    end = math.inf if true["end_s"] is None else true["end_s"]
+    closed = next((e["t"] for e in events if e["event"] == "cleared" and e["t"] >= end), math.inf)
+
+    def in_window(e: dict) -> bool:
+        return onset is not None and onset <= e["t"] <= closed
+
+    detections = [e for e in events if e["event"] == "detected" and in_window(e)]
+    isolations = [e for e in events if e["event"] == "isolated" and in_window(e) and e.get("actuator") == target]
+    identified = [e for e in events if e["event"] == "identified" and in_window(e)
+                  and e.get("actuator") in (target, None) and e.get("value") is not None]
+    decision = None
+    for e in events:
+        if e["event"] == "isolated":
+            decision = e
+        elif e["event"] == "cleared" and decision is not None and e.get("actuator") in (None, decision.get("actuator")):
+            decision = None
+    value = float(identified[-1]["value"]) if identified else None
+    true_value = true["true_value"]
+    return {
+        "events": len(events),
+        "detected": bool(detections),
+        "detection_delay_s": detections[0]["t"] - onset if detections else None,
+        "isolated_actuator": None if decision is None else decision.get("actuator"),
+        "isolated_kind": None if decision is None else decision.get("kind"),
+        "isolation_delay_s": isolations[0]["t"] - onset if isolations else None,
+        "identified_value": value,
+        "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
+        "false_alarms": sum(e["event"] in ALARMS and not in_window(e) for e in events),
+        "ambiguous": any(e["event"] == "ambiguous" for e in events),
+        "unexcited": any(e["event"] == "unexcited" for e in events),
+    }
+
+
+def run_metrics(scenario, result, events: list[dict]) -> dict:
+    """:func:`truth`, :func:`event_metrics` and path_error_rms_m (RMS of the reference's cross-track
+    error over the run, m; None when the result has none)."""
+    true = truth(scenario)
+    reference = result.signals.get("reference")
+    rms = None
+    if reference is not None and "cross_track" in reference.labels:
+        rms = float(np.sqrt(np.mean(np.square(reference["cross_track"]))))
+    return true | event_metrics(true, events) | {"path_error_rms_m": rms}

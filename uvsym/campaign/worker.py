@@ -1,0 +1,102 @@
+"""What a campaign worker does with a run: parse its scenario, simulate it, measure it; one row per run.
+
+A run that raises gives a row with ``status = "error"`` and ``error = "Type: message"``; it never
+ends the campaign. The functions here run in worker processes (local or Dask), so they take
+only picklable arguments.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import time
+
+from uvsym.campaign.metrics import METRIC_COLUMNS, run_metrics, truth
+from uvsym.campaign.spec import Run, Settings
+from uvsym.errors import CampaignError
+
+__all__ = ["load_hook", "execute", "failure_row", "run_chunk", "serve"]
+
+_SCALARS = (bool, int, float, str, type(None))
+
+
+def load_hook(settings: Settings):
+    """The metrics hook ``module:function`` (searched also in the campaign file's folder), or None;
+    CampaignError naming ``metrics`` when it cannot be imported or is not callable."""
+    if settings.metrics is None:
+        return None
+    module_name, _, function = settings.metrics.partition(":")
+    if settings.root not in sys.path:
+        sys.path.append(settings.root)
+    try:
+        hook = getattr(importlib.import_module(module_name), function)
+    except (ImportError, AttributeError) as exc:
+        raise CampaignError(f"metrics: cannot load {settings.metrics!r}: {exc}") from None
+    if not callable(hook):
+        raise CampaignError(f"metrics: {settings.metrics!r} is not callable")
+    return hook
+
+
+def _base(run: Run) -> dict:
+    return {"run_id": run.id, "case": run.case, "draw": run.draw, **run.fields}
+
+
+def failure_row(run: Run, message: str) -> dict:
+    """The error row of a run that gave no row of its own (e.g. its worker process died)."""
+    from uvsym.sim.scenario import parse_scenario
+
+    return _base(run) | truth(parse_scenario(run.scenario)) | {"status": "error", "error": message}
+
+
+def execute(run: Run, settings: Settings, hook=None) -> dict:
+    """Simulate ``run`` and return its row: run_id, case, draw, its fields, status, error, the
+    metrics of :func:`uvsym.campaign.metrics.run_metrics`, the hook's columns and wall_s (s)."""
+    from uvsym.sim.scenario import parse_scenario
+    from uvsym.sim.simulation import simulate_scenario
+
+    started = time.perf_counter()
+    row = _base(run)
+    try:
+        scenario = parse_scenario(run.scenario)
+        row |= truth(scenario)
+        result = simulate_scenario(scenario, **dict(settings.simulation))
+        events = list(getattr(result, "events", None) or [])
+        row |= run_metrics(scenario, result, events)
+        if hook is not None:
+            row |= _hook_columns(hook(scenario, result, events), settings.metrics)
+        row |= {"status": "ok", "error": None}
+    except Exception as exc:  # a run that fails is a row, not the end of the campaign
+        row |= {"status": "error", "error": f"{type(exc).__name__}: {exc}"}
+    row["wall_s"] = time.perf_counter() - started
+    return row
+
+
+def _hook_columns(columns, name: str) -> dict:
+    if not isinstance(columns, dict):
+        raise CampaignError(f"metrics: {name} returned {type(columns).__name__}, not a dict of columns")
+    for key, value in columns.items():
+        if not isinstance(key, str) or key in METRIC_COLUMNS:
+            raise CampaignError(f"metrics: {name} returned the column {key!r}, which is not a new column name")
+        if not isinstance(value, _SCALARS):
+            raise CampaignError(f"metrics: {name} column {key!r}: expected a number, string, bool or None, "
+                                f"got {type(value).__name__}")
+    return columns
+
+
+def run_chunk(runs: list[Run], settings: Settings) -> list[dict]:
+    """The rows of ``runs``, in order (a Dask task)."""
+    hook = load_hook(settings)
+    return [execute(run, settings, hook) for run in runs]
+
+
+def serve(conn, settings: Settings) -> None:
+    """A local worker process: receive runs on ``conn``, send back their rows, until None or the driver goes."""
+    hook = load_hook(settings)
+    while True:
+        try:
+            run = conn.recv()
+            if run is None:
+                return
+            conn.send(execute(run, settings, hook))
+        except (EOFError, OSError):  # the driver has gone: nothing to report to
+            return
