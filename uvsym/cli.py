@@ -321,6 +321,34 @@ def _cmd_verify(args) -> int:
     return 1 if failures else 0
 
 
+def _cmd_campaign(args) -> int:
+    from uvsym.campaign import default_out, load_campaign, run_campaign
+    from uvsym.progress import ProgressBar
+
+    campaign = load_campaign(args.file, confirm=args.yes)
+    if args.dry_run:
+        print(f"{campaign.name}: {len(campaign.runs)} runs in {len({r.case for r in campaign.runs})} cases, every "
+              f"scenario valid; fields: {', '.join(campaign.columns) or 'none'}")
+        return 0
+    bar, drawn = ProgressBar(campaign.name), []
+
+    def progress(fraction: float) -> None:
+        drawn.append(fraction)
+        bar(fraction)
+
+    def log(line: str) -> None:
+        if drawn:
+            bar.close()
+            drawn.clear()
+        print(line, file=sys.stderr, flush=True)
+
+    out = Path(args.out) if args.out else default_out(campaign)
+    run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                 chunk_size=args.chunk_size, progress=progress, force=args.force, log=log)
+    print(f"wrote {out}: results.parquet, results.csv, summary.json, report.md, report.html")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="uvsym", formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -330,6 +358,7 @@ def _parser() -> argparse.ArgumentParser:
         epilog="examples:\n  uvsym models show remus100\n  uvsym simulate docking_faults --out run.npz --plot\n"
                "  uvsym report actuator-observers\n  uvsym verify --json\n"
                "  uvsym codegen actuator-observers -o c_out --vehicle otter3dof\n"
+               "  uvsym campaign examples/campaign_docking.toml --workers 2\n"
                "'uvsym COMMAND --help' gives each command's options.")
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -370,6 +399,19 @@ def _parser() -> argparse.ArgumentParser:
     codegen.add_argument("--no-finite-check", action="store_true",
                          help="wrappers without the NaN/infinity check of inputs and outputs (codes 2 and 3)")
     codegen.set_defaults(run=_cmd_codegen)
+    campaign = sub.add_parser("campaign", help="run a campaign file: scenarios over grids and Monte Carlo draws, "
+                                               "on local processes or Dask; results, summary and report; resumable")
+    campaign.add_argument("file", help="campaign file (TOML)")
+    campaign.add_argument("--out", help="output folder (default: ./campaigns/NAME); rerun to resume")
+    campaign.add_argument("--executor", choices=["local", "dask"], help="where runs execute (default: the file's, "
+                                                                         "else local processes)")
+    campaign.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (implies --executor dask)")
+    campaign.add_argument("--workers", type=int, help="local processes, or LocalCluster workers (default: cores)")
+    campaign.add_argument("--chunk-size", type=int, help="runs per chunk file (default: the file's, else 8)")
+    campaign.add_argument("--yes", action="store_true", help="confirm a campaign of more runs than its max_runs")
+    campaign.add_argument("--dry-run", action="store_true", help="expand and check every run, run none")
+    campaign.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
+    campaign.set_defaults(run=_cmd_campaign)
     verify = sub.add_parser("verify", help="check the derivations' claims by machine; exit 1 if any is unexpected")
     verify.add_argument("names", nargs="*", help="derivations (default: all that make claims)")
     verify.add_argument("--json", action="store_true", help="print the claims as a JSON list")
