@@ -3,15 +3,18 @@
 ``compile_function``: ``casadi.external`` evaluates the compiled code with the same calling
 convention as the original Function, so it is a drop-in replacement. ``compile_roll``: a plain
 C loop over a step Function ``(z, w) -> (z_next, out)``, called once per chunk of steps through
-ctypes -- the fast path of the simulations (see ``benchmarks/sim.py``).
+ctypes -- the fast path of the simulations (see ``benchmarks/sim.py``). ``compile_lanes``: the
+same loop over L independent trajectories side by side, the step's body run as a loop over lanes
+that the compiler vectorises (see ``benchmarks/campaign.py``). Libraries are kept in the compile
+cache (:mod:`uvsym.codegen.cache`), so the same Function is compiled once per machine.
 """
 
 from __future__ import annotations
 
 import atexit
 import ctypes
-import itertools
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -20,15 +23,20 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from uvsym.codegen.cache import cached_library, library_key
 from uvsym.errors import CodegenError
 
-__all__ = ["DEFAULT_FLAGS", "find_compiler", "compile_function", "compile_roll"]
+__all__ = ["DEFAULT_FLAGS", "FAST_FLAGS", "find_compiler", "compile_function", "compile_roll", "compile_lanes"]
 
 # No -ffast-math: a shared library built with it switches the whole process to flush-to-zero
 # on load (crtfastmath), which silently changes every other float computation in Python.
 DEFAULT_FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fPIC", "-shared")
+# The simulation loops: CasADi's helpers (fmin, fmax, sq) called directly rather than through the
+# PLT, and no IEEE special cases the loops do not need; results stay within 1e-10 relative of
+# DEFAULT_FLAGS and a loop that produces NaN is still reported (tests/test_compile_cache.py).
+FAST_FLAGS = DEFAULT_FLAGS + ("-fno-semantic-interposition", "-ffinite-math-only", "-fno-signed-zeros",
+                              "-fno-trapping-math")
 _BUILD_DIR: Path | None = None
-_COUNTER = itertools.count()
 
 
 def find_compiler() -> str | None:
@@ -40,7 +48,7 @@ def find_compiler() -> str | None:
 
 
 def _build_dir() -> Path:
-    """This process's scratch folder for generated sources and libraries, removed at exit."""
+    """This process's scratch folder for generated sources (and libraries the cache cannot hold), removed at exit."""
     global _BUILD_DIR
     if _BUILD_DIR is None:
         _BUILD_DIR = Path(tempfile.mkdtemp(prefix="uvsym-build-"))
@@ -48,32 +56,40 @@ def _build_dir() -> Path:
     return _BUILD_DIR
 
 
-def _build(f: ca.Function, extra_source: str, flags: tuple[str, ...]) -> Path:
-    """Generate ``f`` (with a header) plus ``extra_source``, compile both into a new shared library."""
+def _build(f: ca.Function, extra_source: str, flags: tuple[str, ...], libraries: tuple[str, ...] = ("-lm",),
+           generated=None) -> Path:
+    """Shared library of ``f`` generated as C (with a header) plus ``extra_source``, from the compile cache
+    (compiled into it first when missing). ``generated() -> str``: C to compile instead of CasADi's code
+    for ``f`` and ``extra_source``, called only on a cache miss (``extra_source`` must then name all it depends
+    on besides ``f``)."""
     compiler = find_compiler()
     if compiler is None:
         raise CodegenError("no C compiler found (set $CC or install gcc)")
-    stem = f"{f.name()}_{os.getpid()}_{next(_COUNTER)}"
-    directory = _build_dir()
-    generator = ca.CodeGenerator(stem, {"with_header": True})
-    generator.add(f)
-    generator.generate(f"{directory}{os.sep}")
-    sources = [directory / f"{stem}.c"]
-    if extra_source:
-        sources.append(directory / f"{stem}_driver.c")
-        sources[-1].write_text(f'#include "{stem}.h"\n' + extra_source)
-    library = directory / f"{stem}.so"
-    command = [compiler, *flags, *map(str, sources), "-o", str(library), "-lm"]
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise CodegenError(f"compiling {f.name()} failed: {' '.join(command)}\n{done.stderr.strip()}")
-    return library
+    key = library_key(f, extra_source, flags + libraries, compiler)
+
+    def compile_into(library: Path) -> None:
+        directory = _build_dir()
+        stem = f"{f.name()}_{key[:16]}"
+        sources = []
+        if generated is None:
+            generator = ca.CodeGenerator(stem, {"with_header": True})
+            generator.add(f)
+            generator.generate(f"{directory}{os.sep}")
+            sources.append(directory / f"{stem}.c")
+        if extra_source or generated is not None:
+            sources.append(directory / f"{stem}_driver.c")
+            sources[-1].write_text(generated() if generated is not None else f'#include "{stem}.h"\n' + extra_source)
+        command = [compiler, *flags, *map(str, sources), "-o", str(library), *libraries]
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise CodegenError(f"compiling {f.name()} failed: {' '.join(command)}\n{done.stderr.strip()}")
+
+    return cached_library(key, compile_into, _build_dir())
 
 
 def compile_function(f: ca.Function, flags: tuple[str, ...] = DEFAULT_FLAGS) -> ca.Function:
-    """``f`` generated as C, compiled to a shared library and loaded with ``casadi.external``.
-
-    Every call builds a library with a new file name (the loader caches by path).
+    """``f`` generated as C, compiled to a shared library (or taken from the compile cache) and
+    loaded with ``casadi.external``.
 
     Raises
     ------
@@ -105,8 +121,32 @@ int {name}_roll(const casadi_real* z0, const casadi_real* W, casadi_real* z_end,
 }}
 """
 
+_POINTER = ctypes.POINTER(ctypes.c_double)
 
-def compile_roll(step: ca.Function, flags: tuple[str, ...] = DEFAULT_FLAGS):
+
+def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...]):
+    """roll(z0, W, out) -> z_end calling ``symbol`` of ``library``; ``lanes``: () or (L,), the trailing axis."""
+    n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
+    function = getattr(ctypes.CDLL(str(library)), symbol)
+    function.argtypes = [_POINTER, _POINTER, _POINTER, _POINTER, ctypes.c_long]
+
+    def roll(z0: np.ndarray, W: np.ndarray, out: np.ndarray) -> np.ndarray:
+        z0 = np.ascontiguousarray(z0, dtype=float)
+        if z0.shape != (n_z, *lanes) or W.shape[1:] != (n_w, *lanes) or out.shape != (W.shape[0], n_out, *lanes) \
+                or not (W.flags.c_contiguous and out.flags.c_contiguous):
+            shape = "".join(f", {size}" for size in lanes)
+            raise CodegenError(f"roll needs z0 ({n_z}{shape}) and C-contiguous W (k, {n_w}{shape}) and "
+                               f"out (k, {n_out}{shape})")
+        z_end = np.empty_like(z0)
+        if function(z0.ctypes.data_as(_POINTER), W.ctypes.data_as(_POINTER), z_end.ctypes.data_as(_POINTER),
+                    out.ctypes.data_as(_POINTER), W.shape[0]):
+            raise CodegenError(f"{step.name()} failed inside the compiled loop")
+        return z_end
+
+    return roll
+
+
+def compile_roll(step: ca.Function, flags: tuple[str, ...] = FAST_FLAGS):
     """A C loop over ``step(z, w) -> (z_next, out)`` (dense vectors), compiled and loaded.
 
     Returns ``roll(z0 (n_z,), W (k, n_w), out (k, n_out)) -> z_end``: k steps, one row of W per
@@ -117,19 +157,94 @@ def compile_roll(step: ca.Function, flags: tuple[str, ...] = DEFAULT_FLAGS):
     """
     n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
     library = _build(step, _ROLL.format(name=step.name(), n_z=n_z, n_w=n_w, n_out=n_out), flags)
-    function = getattr(ctypes.CDLL(str(library)), f"{step.name()}_roll")
-    pointer = ctypes.POINTER(ctypes.c_double)
-    function.argtypes = [pointer, pointer, pointer, pointer, ctypes.c_long]
+    return _roller(step, library, f"{step.name()}_roll", ())
 
-    def roll(z0: np.ndarray, W: np.ndarray, out: np.ndarray) -> np.ndarray:
-        z0 = np.ascontiguousarray(z0, dtype=float)
-        if W.shape[1:] != (n_w,) or out.shape != (W.shape[0], n_out) or not (W.flags.c_contiguous and
-                                                                            out.flags.c_contiguous):
-            raise CodegenError(f"roll needs C-contiguous W (k, {n_w}) and out (k, {n_out})")
-        z_end = np.empty(n_z)
-        if function(z0.ctypes.data_as(pointer), W.ctypes.data_as(pointer), z_end.ctypes.data_as(pointer),
-                    out.ctypes.data_as(pointer), W.shape[0]):
-            raise CodegenError(f"{step.name()} failed inside the compiled loop")
-        return z_end
 
-    return roll
+# Math functions with a vector variant in glibc's libmvec (x86-64; 2.22, the rest 2.35): declared
+# SIMD-callable so the lane loop vectorises through them (glibc declares them so only under -ffast-math).
+# A libmvec without one fails the link (-z defs), and the lanes fall back to scalar runs.
+_VECTOR_MATH = ("sin", "cos", "exp", "log", "pow", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
+                "hypot", "expm1", "log1p", "cbrt")
+_TWO_ARGUMENTS = {"pow", "atan2", "hypot"}
+_SCALAR_OK = {"sqrt", "fabs", "floor", "ceil", "fmin", "fmax", "copysign", "trunc", "round"}
+_LANE_HELPERS = """#include <math.h>
+#include <string.h>
+#define casadi_real double
+static inline double casadi_sq(double x) { return x * x; }
+static inline double casadi_fmin(double x, double y) { return (y != y || x < y) ? x : y; }
+static inline double casadi_fmax(double x, double y) { return (y != y || x > y) ? x : y; }
+static inline double casadi_sign(double x) { return x < 0 ? -1. : x > 0 ? 1. : x; }
+"""
+_LANES = """
+static void {name}_lanes_step(const double* restrict in0, const double* restrict in1, double* restrict out0,
+                              double* restrict out1) {{
+  #pragma omp simd
+  for (long l = 0; l < {L}; ++l) {{
+{body}
+  }}
+}}
+int {name}_lanes_roll(const double* z0, const double* W, double* z_end, double* O, long N) {{
+  double z[{n_z} * {L}], zn[{n_z} * {L}];
+  memcpy(z, z0, sizeof z);
+  for (long k = 0; k < N; ++k) {{
+    {name}_lanes_step(z, W + k * {n_w} * {L}, zn, O + k * {n_out} * {L});
+    memcpy(z, zn, sizeof z);
+  }}
+  memcpy(z_end, z, sizeof z);
+  return 0;
+}}
+"""
+
+
+def _lane_body(step: ca.Function) -> str:
+    """The body of CasADi's C for ``step`` rewritten for lane ``l`` of structure-of-arrays buffers (entry j of
+    lane l at ``j * L + l``); CodegenError when it holds anything but straight-line scalar code."""
+    bodies = re.findall(r"\nstatic int casadi_f\d+\([^)]*\) \{\n(.*?)\n  return 0;\n\}", _generated(step), re.S)
+    if len(bodies) != 1:
+        raise CodegenError(f"{step.name()}: expected one generated function body, found {len(bodies)}")
+    body = re.sub(r"arg\[([01])\]\? arg\[\1\]\[(\d+)\] : 0", r"in\1[\2 * L + l]", bodies[0])
+    body = re.sub(r"if \(res\[([01])\]!=0\) res\[\1\]\[(\d+)\]=", r"out\1[\2 * L + l]=", body)
+    calls = set(re.findall(r"([A-Za-z_]\w*)\(", body)) - set(_VECTOR_MATH) - _SCALAR_OK
+    calls -= {"casadi_sq", "casadi_fmin", "casadi_fmax", "casadi_sign"}
+    if calls or re.search(r"\b(arg|res|iw|w|for|while)\b", body):
+        raise CodegenError(f"{step.name()}: its generated code is not straight-line scalar code the lanes can run "
+                           f"(calls {sorted(calls)})")
+    return body
+
+
+def _generated(step: ca.Function) -> str:
+    """CasADi's C for ``step`` as text."""
+    generator = ca.CodeGenerator(f"{step.name()}_lanes")
+    generator.add(step)
+    return generator.dump()
+
+
+def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_FLAGS):
+    """``step(z, w) -> (z_next, out)`` run for ``lanes`` trajectories at once, in a C loop over lanes that
+    gcc vectorises (glibc's vector math for sin, cos, exp, log, pow).
+
+    Returns ``roll(z0 (n_z, L), W (k, n_w, L), out (k, n_out, L)) -> z_end (n_z, L)``: k steps of every
+    lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays).
+
+    Raises CodegenError when there is no compiler, the step is not straight-line scalar code, or
+    compilation (or linking with libmvec) fails.
+    """
+    if not (isinstance(lanes, int) and lanes >= 1):
+        raise CodegenError(f"lanes must be a positive integer, got {lanes!r}")
+    n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
+    # what the source depends on besides the step: the key is known without generating it
+    recipe = "\0".join((_LANE_HELPERS, _LANES, *_VECTOR_MATH, str(lanes)))
+
+    def source() -> str:
+        body = _lane_body(step)
+        used = [name for name in _VECTOR_MATH if re.search(rf"\b{name}\(", body)]
+        declarations = "".join(f'double {name}(double{", double" * (name in _TWO_ARGUMENTS)}) '
+                               f'__attribute__((simd("notinbranch"), const, nothrow));\n' for name in used)
+        return (_LANE_HELPERS + declarations + f"#define L {lanes}\n"
+                + _LANES.format(name=step.name(), L=lanes, n_z=n_z, n_w=n_w, n_out=n_out, body=body))
+
+    # not builtins: gcc would otherwise fuse sin and cos of one angle into a sincos it cannot vectorise
+    not_builtin = tuple(f"-fno-builtin-{name}" for name in _VECTOR_MATH)
+    library = _build(step, recipe, (*flags, *not_builtin, "-fopenmp-simd", "-Wl,-z,defs"), ("-lmvec", "-lm"),
+                     generated=source)
+    return _roller(step, library, f"{step.name()}_lanes_roll", (lanes,))

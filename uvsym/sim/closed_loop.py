@@ -3,8 +3,16 @@
 State ``z = [x (2 dof); a (m); xc; xo; a_expected (m); held (2 dof)]``: plant state, actuator
 state, controller state, observer states, the response a healthy actuator would give to the
 commands (the actuator model run in the controller), and the sensor latch of stuck faults. Per-sample input
-``w = [t; noise (2 dof); V_c; beta_c; vec(S) (m m); o (m)]``: time, standard normal draws, the
-current, and the command correction ``u_cmd = sat(S u_d + o)`` set by a supervisor.
+``w = [t; noise (2 dof); V_c; beta_c; vec(S) (m m); o (m); D (m J); B (m J)]``: time, standard normal
+draws, the current, the command correction ``u_cmd = sat(S u_d + o)`` set by a supervisor, and the
+actuator faults at the J = 2 substeps + 1 distinct RK4 stage times of the sample.
+
+Every actuator fault kind is affine in the value v it acts on (``ActuatorKind.affine``), and so is
+its blend ``v + phi (deliver(v) - v)`` with the profile phi(t), and a chain of them: the fixed-step
+path applies ``a + D_j a + B_j`` (D_j = 0, B_j = 0 healthy), with (D_j, B_j) worked out in numpy
+from the fault list (:func:`actuator_fault_columns`). One compiled step thus serves every actuator
+fault of a loop, and lanes of a batch can differ in them. The integrators' ``plant_ode`` keeps the
+faults symbolic in continuous time.
 
 At each sample the discrete part measures ``y`` (sensor faults), runs the controller and the
 observers, and holds ``u_cmd`` over the sample; the plant ``[x; a]`` is then integrated over
@@ -15,13 +23,15 @@ so that an actuator's own lag is not mistaken for a fault.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import casadi as ca
+import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
-from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
+from uvsym.faults import ActuatorFault, SensorFault, _check_index, apply_actuator_faults, apply_sensor_faults
 from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
 from uvsym.observers.base import Observer
@@ -29,7 +39,7 @@ from uvsym.sim.controllers import Autopilot
 from uvsym.sim.loop import SampledLoop, logged_signals
 from uvsym.symbolic import rk4
 
-__all__ = ["ClosedLoop", "build_closed_loop"]
+__all__ = ["ClosedLoop", "build_closed_loop", "actuator_fault_columns"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -37,12 +47,14 @@ class ClosedLoop(SampledLoop):
     """The marine scenario loop (module docstring for z and w; the runner's fields in
     :class:`~uvsym.sim.loop.SampledLoop`). ``layout`` maps x, a, xc, xo, a_expected, held to
     their slices; ``observers`` the estimators by name, ``observer_slices`` their states within
-    xo. ``env_columns``, ``correction_columns``: where w holds (V_c, beta_c) and (vec(S), o).
+    xo. ``env_columns``, ``correction_columns``, ``fault_columns``: where w holds (V_c, beta_c),
+    (vec(S), o) and the actuator faults (D, B), filled by :func:`actuator_fault_columns`.
     """
 
     model: Model
     observer_slices: dict
     observers: dict[str, Observer]
+    fault_columns: slice
 
 
 def _by_name(names: tuple[str, ...], available: dict, observer: str):
@@ -78,13 +90,15 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     layout, start = {}, 0
     for part, size in (("x", n), ("a", m), ("xc", n_c), ("xo", n_o), ("a_expected", m), ("held", n)):
         layout[part], start = slice(start, start + size), start + size
-    n_z, n_w, n_s = start, 1 + n + 2 + m * m + m, n + m
+    stages = 2 * substeps + 1  # distinct RK4 stage times in a sample: t + j dt / (2 substeps)
+    n_z, n_w, n_s = start, 1 + n + 2 + m * m + m + 2 * m * stages, n + m
 
     z, w = ca.SX.sym("z", n_z), ca.SX.sym("w", n_w)
     x, xc, xo, a_expected, held = (z[layout[p]] for p in ("x", "xc", "xo", "a_expected", "held"))
     t, noise, V_c, beta_c = w[0], w[1:1 + n], w[1 + n], w[2 + n]
     S = ca.reshape(w[3 + n:3 + n + m * m], m, m)
-    o = w[3 + n + m * m:]
+    o = w[3 + n + m * m:3 + n + m * m + m]
+    faults = ca.reshape(w[3 + n + m * m + m:], m, 2 * stages)  # column j: D_j, column J + j: B_j
 
     y, held_next = apply_sensor_faults(x, t, sensor_faults, held, noise)
     xc_next, u_d, refs = controller.law(xc, y, dt, model)
@@ -106,7 +120,7 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
         start += size
 
     a_now = z[layout["a"]]
-    u_actual = apply_actuator_faults(a_now, t, actuator_faults)
+    u_actual = a_now + (faults[:, 0] * a_now + faults[:, stages])
     out_parts = {
         "x": (x, model.state_labels, model.state_units),
         "y": (y, model.state_labels, model.state_units),
@@ -137,12 +151,55 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     s_dot = ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(s[n:], uc))
     plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
 
+    half = dt / (2 * substeps)
+
+    def stage_ode(s, u_cmd, env, offset):
+        """s_dot at ``offset`` s into the sample (rk4 runs from 0 here), faults from w's stage column."""
+        j = round(offset / half)
+        a = s[n:]
+        applied = a + (faults[:, j] * a + faults[:, stages + j])
+        return ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(a, u_cmd))
+
     env_step = ca.vertcat(V_c, beta_c) if current is None else ca.DM(current)
-    s_next = rk4(plant_ode, z[:n_s], dt, substeps, u_cmd, env_step, t=t)
+    s_next = rk4(stage_ode, z[:n_s], dt, substeps, u_cmd, env_step)
     # named apart from libc's regex step(): a C caller of an exported "step" may reach that one
     step = ca.Function("closed_loop_step", [z, w], [ca.densify(ca.vertcat(s_next, z_disc)), out],
                        ["z", "w"], ["z_next", "out"], {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
                       plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
                       observers={obs.name: obs for obs in observers}, signals=signals, env_columns=slice(1 + n, 3 + n),
-                      correction_columns=slice(3 + n, n_w))
+                      correction_columns=slice(3 + n, 3 + n + m * m + m), fault_columns=slice(3 + n + m * m + m, n_w))
+
+
+def actuator_fault_columns(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], N: int) -> np.ndarray:
+    """w's fault columns (N + 1, 2 m J) for ``faults`` at the sample times k dt, k = 0..N: per stage j the
+    (D_j, B_j) with ``applied = a + D_j a + B_j`` at ``k dt + j dt / (2 substeps)``, faults composed in order.
+
+    A fault ``v -> v + phi (g v + b - v)`` (``(g, b) = kind.affine(value)``) maps ``(D, B)`` to
+    ``(D + c + c D, B + c B + phi b)`` with ``c = phi (g - 1)``.
+    """
+    m, stages = loop.model.n_inputs, 2 * loop.substeps + 1
+    D, B = np.zeros((N + 1, stages, m)), np.zeros((N + 1, stages, m))
+    for fault in faults:
+        _check_index(fault.actuator, m, "actuator")
+        gain, shift = fault.kind_object.affine(fault.value)
+        phi = _stage_phi(fault.profile, loop.dt, loop.substeps, N)
+        c = phi * (gain - 1.0)
+        d, b = D[:, :, fault.actuator], B[:, :, fault.actuator]
+        D[:, :, fault.actuator], B[:, :, fault.actuator] = d + c + c * d, b + c * b + phi * shift
+    return np.concatenate([D.reshape(N + 1, -1), B.reshape(N + 1, -1)], axis=1)
+
+
+@functools.lru_cache(maxsize=32)
+def _stage_phi(profile, dt: float, substeps: int, N: int) -> np.ndarray:
+    """phi (N + 1, J) at the stage times, evaluated by CasADi as the symbolic step would (kept: reruns reuse it).
+
+    Stage j of sample k is at ``(k dt + (j // 2) dh) + dh / 2`` for odd j (``dh = dt / substeps``), as
+    :func:`uvsym.symbolic.rk4` forms its times (exactly so for one substep).
+    """
+    dh = dt / substeps
+    t = dt * np.arange(N + 1)  # as sample_inputs writes them
+    times = np.column_stack([t + (j // 2) * dh + (dh / 2 if j % 2 else 0.0) for j in range(2 * substeps + 1)])
+    phi = np.asarray(profile.phi(ca.DM(times.reshape(-1)))).reshape(times.shape)
+    phi.setflags(write=False)
+    return phi

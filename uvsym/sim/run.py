@@ -31,7 +31,8 @@ from uvsym.observers.ftc import Correction
 from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
 
-__all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop", "check_memory", "memory_needed"]
+__all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop", "check_chunk", "check_memory",
+           "memory_needed"]
 
 METHODS = ("fast", "cvodes", "idas", "rk", "collocation")
 MAX_SAMPLES = 1e12  # beyond any machine's memory at 8 bytes a sample and signal
@@ -96,17 +97,7 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     for start in range(0, N, chunk):
         k = min(chunk, N - start)
         z = advance(z, W[start:start + k], outputs[start:start + k])
-        rows = outputs[start:start + k]
-        finite = np.all(np.isfinite(rows), axis=1)
-        bad = np.flatnonzero(~finite)
-        if guard is not None:
-            guard(W[start:start + (bad[0] if bad.size else k), 0], rows[:bad[0] if bad.size else k])
-        if bad.size or not np.all(np.isfinite(z)):
-            first = start + (bad[0] if bad.size else k)
-            what = _first_non_finite(loop, outputs[first]) if bad.size else "its state"
-            raise SimulationError(f"the loop diverged: {what} is non-finite from t = {first * loop.dt:.6g} s "
-                                  f"({method}); look for an unstable loop (gains, signs), a model that gives NaN "
-                                  "there, or too large a step")
+        check_chunk(loop, method, start, W[start:start + k], outputs[start:start + k], z, guard)
         if supervisor is not None:
             signals = {name: outputs[start:start + k, sl] for name, (sl, _, _) in loop.signals.items()}
             decision = supervisor.update(W[start:start + k, 0], signals)
@@ -120,6 +111,21 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     signals = {name: Signal(outputs[:, sl].copy(), labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
     return SimResult(W[:, 0].copy(), signals, {}), timing
+
+
+def check_chunk(loop: SampledLoop, method: str, start: int, W_rows: np.ndarray, rows: np.ndarray, z: np.ndarray,
+                guard=None) -> None:
+    """The guard, then SimulationError naming the first non-finite logged entry (or the state z at
+    the chunk's end) of the k samples from sample ``start``: W_rows (k, n_w), rows (k, n_out) logged."""
+    bad = np.flatnonzero(~np.all(np.isfinite(rows), axis=1))
+    k = bad[0] if bad.size else len(rows)
+    if guard is not None:
+        guard(W_rows[:k, 0], rows[:k])
+    if bad.size or not np.all(np.isfinite(z)):
+        what = _first_non_finite(loop, rows[k]) if bad.size else "its state"
+        raise SimulationError(f"the loop diverged: {what} is non-finite from t = {(start + k) * loop.dt:.6g} s "
+                              f"({method}); look for an unstable loop (gains, signs), a model that gives NaN "
+                              "there, or too large a step")
 
 
 def _first_non_finite(loop: SampledLoop, row: np.ndarray) -> str:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 
 from uvsym.conventions import FORCE_LABELS
@@ -13,14 +16,27 @@ from uvsym.observers import ActuatorObserver, actuator_observer
 from uvsym.observers.base import Observer
 from uvsym.observers.discrete import actuator_fault_observer
 from uvsym.observers.gains import design_gains
-from uvsym.sim.closed_loop import build_closed_loop
+from uvsym.sim.closed_loop import ClosedLoop, actuator_fault_columns, build_closed_loop
 from uvsym.sim.controllers import Autopilot
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
 
-__all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers", "current_profile"]
+__all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers", "current_profile", "PreparedRun",
+           "prepare_run", "scenario_arguments"]
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """A run of :func:`simulate` ready for the runner: its loop, initial state z0 (n_z,), per-sample
+    inputs W (N + 1, n_w), the attitude guard (None below 6 DOF) and the result's meta (no timings)."""
+
+    loop: ClosedLoop
+    z0: np.ndarray
+    W: np.ndarray
+    guard: Callable | None
+    meta: dict
 
 
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
@@ -50,6 +66,26 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     fault_actuator (u_actual - healthy), fault_sensor (y - x), tau_desired, reference and
     f_hat/<observer>, one row per grid time ``0, dt, ..., duration``.
     """
+    run = prepare_run(model, controller, duration=duration, dt=dt, eta0=eta0, nu0=nu0, actuators0=actuators0,
+                      current=current, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
+                      observers=observers, method=method, substeps=substeps, seed=seed)
+    result, timing = run_closed_loop(run.loop, run.z0, run.W, method=method, supervisor=supervisor, options=options,
+                                     compiled=compiled, progress=progress, guard=run.guard)
+    return SimResult(result.t, result.signals, {**run.meta, **timing})
+
+
+def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0, actuators0=None,
+                current=(0.0, 0.0), actuator_faults: tuple[ActuatorFault, ...] = (),
+                sensor_faults: tuple[SensorFault, ...] = (), observers: tuple[Observer, ...] = (),
+                method: str = "fast", substeps: int = 1, seed: int = 0, current_in_w: bool = False,
+                loop: ClosedLoop | None = None) -> PreparedRun:
+    """The loop, z0, W, guard and meta of :func:`simulate` (same arguments), checked, before anything runs.
+
+    current_in_w: read a constant current from W rather than build it into the step (so runs with
+    different currents share one compiled step, as the lanes of a batch do). loop: one already built
+    for this model, controller, dt, sensor faults, observers and substeps with ``current=None``, to
+    share (its fixed-step ``step`` takes the actuator faults from W; its ``plant_ode`` is not used).
+    """
     N = grid(duration, dt)
     env = np.asarray(current, dtype=float)
     per_sample(env, 2, N, "current (V_c m/s, beta_c rad)")
@@ -60,13 +96,15 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
             Tzyx(x0[3], x0[4])
         except KinematicsError as exc:
             raise KinematicsError(f"eta0: {exc}") from None
-    loop = build_closed_loop(model, controller, dt, actuator_faults=tuple(actuator_faults),
-                             sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
-                             current=tuple(env) if env.shape == (2,) else None)
+    if loop is None:
+        loop = build_closed_loop(model, controller, dt, actuator_faults=tuple(actuator_faults),
+                                 sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
+                                 current=tuple(env) if env.shape == (2,) and not current_in_w else None)
     check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
-    W = sample_inputs(loop.n_w, N, dt, n, seed)  # one row per sample: [t, noise, V_c, beta_c, vec(S), o]
-    W[:, 1 + n:3 + n] = env.reshape(-1, 2)
-    W[:, 3 + n:] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
+    W = sample_inputs(loop.n_w, N, dt, n, seed)  # one row per sample: [t, noise, V_c, beta_c, vec(S), o, D, B]
+    W[:, loop.env_columns] = env.reshape(-1, 2)
+    W[:, loop.correction_columns] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
+    W[:, loop.fault_columns] = actuator_fault_columns(loop, tuple(actuator_faults), N)
 
     lay = loop.layout
     z0 = np.zeros(loop.n_z)
@@ -82,14 +120,11 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
         z0[lay["xo"].start + sl.start:lay["xo"].start + sl.stop] = obs.initial_state(
             [measured[n] for n in obs.reads_y.names], [desired[n] for n in obs.reads_u.names])
 
-    result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
-                                     compiled=compiled, progress=progress,
-                                     guard=_attitude_guard(loop) if dof == 6 else None)
     meta = {"vehicle": model.name, "method": method, "dt_s": dt, "duration_s": duration, "substeps": substeps,
             "seed": seed, "observers": [obs.name for obs in observers],
             "actuator_faults": [fault_summary(f, model.input_labels[f.actuator]) for f in actuator_faults],
-            "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults], **timing}
-    return SimResult(result.t, result.signals, meta)
+            "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults]}
+    return PreparedRun(loop, z0, W, _attitude_guard(loop) if dof == 6 else None, meta)
 
 
 def _attitude_guard(loop):
@@ -163,11 +198,33 @@ def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...], dt: float) ->
 
 def simulate_scenario(scenario: Scenario, *, method: str = "fast", supervisor: Supervisor | None = None,
                       progress=None, **options) -> SimResult:
-    """Run a validated :class:`Scenario`; keyword options go to :func:`simulate` (e.g. substeps)."""
-    result = simulate(scenario.model, scenario.controller, duration=scenario.duration, dt=scenario.step,
-                      eta0=scenario.eta0, nu0=scenario.nu0, actuators0=scenario.actuators0,
-                      current=current_profile(scenario), actuator_faults=scenario.actuator_faults,
-                      sensor_faults=scenario.sensor_faults,
-                      observers=observer_blocks(scenario.model, scenario.observers, scenario.step),
-                      supervisor=supervisor, method=method, seed=scenario.seed, progress=progress, **options)
-    return SimResult(result.t, result.signals, {"scenario": scenario.name, **result.meta})
+    """Run a validated :class:`Scenario`; keyword options go to :func:`simulate` (e.g. substeps).
+
+    A scenario with a [diagnosis] table runs its :class:`~uvsym.diagnosis.ActuatorDiagnosis`: in the
+    loop when it corrects the commands, else on the finished record (the same decisions, faster);
+    the result's ``events`` hold its decision log (unless ``supervisor`` replaces it).
+    """
+    diagnosis = None
+    if scenario.diagnosis is not None and supervisor is None:
+        from uvsym.diagnosis.run import diagnosis_for  # the diagnosis package builds on this module
+
+        diagnosis = diagnosis_for(scenario)
+        supervisor = diagnosis if scenario.diagnosis.correct else None
+    result = simulate(scenario.model, scenario.controller, **scenario_arguments(scenario), supervisor=supervisor,
+                      method=method, progress=progress, **options)
+    meta = {"scenario": scenario.name, **result.meta}
+    if diagnosis is not None:
+        if supervisor is None:
+            diagnosis.update(result.t, {name: result[name].values for name in diagnosis.reads})
+        meta["events"] = [event.as_dict() for event in diagnosis.events]
+    return SimResult(result.t, result.signals, meta)
+
+
+def scenario_arguments(scenario: Scenario, observers: tuple[Observer, ...] | None = None) -> dict:
+    """The keyword arguments of :func:`simulate` (and :func:`prepare_run`) a scenario sets, past model and
+    controller; ``observers``: its :func:`observer_blocks` when the caller has them already."""
+    return {"duration": scenario.duration, "dt": scenario.step, "eta0": scenario.eta0, "nu0": scenario.nu0,
+            "actuators0": scenario.actuators0, "current": current_profile(scenario),
+            "actuator_faults": scenario.actuator_faults, "sensor_faults": scenario.sensor_faults,
+            "observers": observer_blocks(scenario.model, scenario.observers, scenario.step) if observers is None
+            else observers, "seed": scenario.seed}

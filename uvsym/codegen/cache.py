@@ -1,0 +1,80 @@
+"""Compiled libraries kept between runs, named by the SHA-256 of everything that determines them.
+
+The key hashes the serialised CasADi Function, the extra C source compiled with it, the compiler
+flags, the compiler's identity (first line of ``cc --version``) and the CasADi version, so a
+library is reused only when it would be compiled again byte for byte. The folder is
+``$UVSYM_CACHE_DIR``, else ``$XDG_CACHE_HOME/uvsym``, else ``~/.cache/uvsym``; deleting it (or any
+file in it) is always safe. A library is compiled under a temporary name and moved into place with
+``os.replace``, so two processes compiling the same key at once both end with a whole library.
+An unwritable folder falls back to this process's temporary build folder, with a warning.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import itertools
+import os
+import subprocess
+import warnings
+from pathlib import Path
+from typing import Callable
+
+import casadi as ca
+
+__all__ = ["CACHE_ENV", "cache_dir", "library_key", "cached_library"]
+
+CACHE_ENV = "UVSYM_CACHE_DIR"
+_COUNTER = itertools.count()
+_WARNED: set[str] = set()
+
+
+def cache_dir() -> Path:
+    """``$UVSYM_CACHE_DIR``, else ``$XDG_CACHE_HOME/uvsym``, else ``~/.cache/uvsym`` (not created here)."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV]).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base).expanduser() / "uvsym"
+
+
+@functools.lru_cache(maxsize=None)
+def _compiler_identity(compiler: str) -> str:
+    """First line of ``compiler --version`` ('' when it prints nothing)."""
+    done = subprocess.run([compiler, "--version"], capture_output=True, text=True)
+    return (done.stdout.strip().splitlines() or [""])[0]
+
+
+def library_key(f: ca.Function, extra_source: str, flags: tuple[str, ...], compiler: str) -> str:
+    """Hex SHA-256 of ``f.serialize()``, ``extra_source``, ``flags``, the compiler and CasADi version."""
+    digest = hashlib.sha256()
+    for part in (f.serialize(), extra_source, "\0".join(flags), compiler, _compiler_identity(compiler),
+                 ca.__version__):
+        digest.update(part.encode() if isinstance(part, str) else bytes(part))
+        digest.update(b"\0\1\0")
+    return digest.hexdigest()
+
+
+def cached_library(key: str, build: Callable[[Path], None], fallback: Path) -> Path:
+    """The library for ``key`` in the cache folder, calling ``build(path)`` to compile it there first when
+    it is missing. ``fallback``: the folder used (with a warning) when the cache folder cannot be written."""
+    folder = cache_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise PermissionError(f"{folder} is not writable")
+    except OSError as exc:
+        if str(folder) not in _WARNED:
+            _WARNED.add(str(folder))
+            warnings.warn(f"compile cache folder unusable ({exc}); compiling into a temporary folder instead "
+                          f"(set ${CACHE_ENV} to a writable folder)", stacklevel=4)
+        folder = fallback
+    library = folder / f"{key}.so"
+    if library.exists():
+        return library
+    partial = folder / f"{key}.{os.getpid()}.{next(_COUNTER)}.part"
+    try:
+        build(partial)
+        os.replace(partial, library)
+    finally:
+        partial.unlink(missing_ok=True)
+    return library

@@ -1,0 +1,132 @@
+"""``simulate_batch``: many runs of one closed loop at once, in lanes of one compiled step.
+
+Runs that share the compiled step -- the same vehicle, controller, observers, sensor faults, step,
+duration and substeps -- differ freely in initial state, current, actuator faults (they are
+per-sample inputs of the step, :mod:`uvsym.sim.closed_loop`) and noise seed. They run ``lanes`` at
+a time through :func:`uvsym.codegen.compile_lanes`: one C loop over the steps whose body runs every
+lane side by side, vectorised by the compiler. Each run's result equals :func:`simulate_scenario`'s
+for it up to rounding (the vector math library's sin, cos, ... differ from the scalar ones in the
+last bits; tests/test_batch.py). A run needing a supervisor (Python logic between chunks) cannot
+run in lanes: :func:`simulate_batch` refuses one, :func:`simulate_scenario` runs it.
+Without a C compiler, or for a step the lanes cannot run, every run falls back to the scalar path
+(with a warning).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Sequence
+
+import numpy as np
+
+from uvsym.codegen.compile import compile_lanes
+from uvsym.errors import CodegenError, SimulationError
+from uvsym.sim.closed_loop import build_closed_loop
+from uvsym.sim.result import Signal, SimResult
+from uvsym.sim.run import CHUNK, check_chunk, run_closed_loop
+from uvsym.sim.scenario import Scenario
+from uvsym.sim.simulation import PreparedRun, observer_blocks, prepare_run, scenario_arguments
+
+__all__ = ["LANES", "simulate_batch", "run_lanes"]
+
+LANES = 8  # trajectories per compiled step (benchmarks/campaign.py measures the choice)
+
+
+def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substeps: int = 1, compiled: bool = True,
+                   supervisor=None) -> list[SimResult]:
+    """Each scenario run as :func:`simulate_scenario` (method ``fast``) would, in lanes of shared compiled steps.
+
+    Scenarios share a loop when they share the model and controller objects (e.g. made with
+    ``dataclasses.replace`` from one scenario) and their observers, sensor faults, step and duration;
+    each such group runs in lanes. Results are in the order of ``scenarios``; meta as
+    :func:`simulate_scenario`'s plus ``lanes`` (lanes per compiled step), ``wall_s`` being the group's.
+
+    Raises
+    ------
+    SimulationError
+        For a supervisor (lanes run without Python in the loop), and as :func:`simulate_scenario` does
+        for a run that diverges (naming the scenario).
+    """
+    if supervisor is not None:
+        raise SimulationError("simulate_batch runs without a supervisor (no Python between the steps of the lanes); "
+                              "run supervised scenarios with simulate_scenario")
+    groups: dict[tuple, list[int]] = {}
+    for i, scenario in enumerate(scenarios):
+        if not isinstance(scenario, Scenario):
+            raise SimulationError(f"scenarios[{i}] must be a Scenario, got {type(scenario).__name__}")
+        shape = (id(scenario.model), id(scenario.controller), scenario.observers, scenario.sensor_faults,
+                 scenario.step, scenario.duration)
+        groups.setdefault(shape, []).append(i)
+    results: list[SimResult | None] = [None] * len(scenarios)
+    for members in groups.values():
+        first = scenarios[members[0]]
+        observers = observer_blocks(first.model, first.observers, first.step)
+        loop = build_closed_loop(first.model, first.controller, first.step, sensor_faults=first.sensor_faults,
+                                 observers=observers, substeps=substeps)
+        runs = [prepare_run(scenarios[i].model, scenarios[i].controller, **scenario_arguments(scenarios[i], observers),
+                            substeps=substeps, loop=loop) for i in members]
+        names = [scenarios[i].name for i in members]
+        for i, result in zip(members, run_lanes(runs, lanes=lanes, compiled=compiled, names=names)):
+            results[i] = SimResult(result.t, result.signals, {"scenario": scenarios[i].name, **result.meta})
+    return results
+
+
+def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool = True,
+              names: Sequence[str] | None = None) -> list[SimResult]:
+    """Runs prepared on ONE shared loop (:func:`prepare_run` with ``loop=``) and the same grid, ``lanes`` at a time.
+
+    Returns one SimResult per run (meta: the run's, ``lanes``, ``wall_s`` and ``build_s`` of the
+    batch). ``names`` label the runs in errors (default: their index). Falls back to one scalar run
+    after another (with a warning) when the lanes cannot be compiled.
+    """
+    if not runs:
+        return []
+    loop, N = runs[0].loop, runs[0].W.shape[0] - 1
+    for i, run in enumerate(runs):
+        if run.loop is not loop or run.W.shape != runs[0].W.shape:
+            raise SimulationError(f"run {i} does not share the first run's loop and grid; prepare them with one loop")
+    names = [str(i) for i in range(len(runs))] if names is None else list(names)
+    started = time.perf_counter()
+    try:
+        if not compiled:
+            raise CodegenError("compiled=False")
+        roll = compile_lanes(loop.step, lanes)
+    except CodegenError as exc:
+        if compiled:
+            warnings.warn(f"running the batch one run after another: {exc}", stacklevel=2)
+        return [_scalar(run, compiled) for run in runs]
+    build_s = time.perf_counter() - started
+    results = []
+    for first in range(0, len(runs), lanes):
+        group = list(runs[first:first + lanes])
+        group += group[-1:] * (lanes - len(group))  # padding lanes repeat the last run
+        started = time.perf_counter()
+        W = np.ascontiguousarray(np.stack([run.W for run in group], axis=-1))
+        z = np.ascontiguousarray(np.stack([run.z0 for run in group], axis=-1))
+        outputs = np.empty((N + 1, loop.discrete.size1_out("out"), lanes))
+        guards = [run.guard for run in group]
+        for start in range(0, N, CHUNK["fast"]):
+            k = min(CHUNK["fast"], N - start)
+            z = roll(z, W[start:start + k], outputs[start:start + k])
+            for lane in range(min(lanes, len(runs) - first)):
+                try:
+                    check_chunk(loop, "fast", start, W[start:start + k, :, lane], outputs[start:start + k, :, lane],
+                                z[:, lane], guards[lane])
+                except SimulationError as exc:
+                    raise SimulationError(f"run {names[first + lane]}: {exc}") from None
+        for lane in range(min(lanes, len(runs) - first)):
+            outputs[N, :, lane] = np.asarray(loop.discrete(z[:, lane], W[N, :, lane])[2]).ravel()
+        wall = time.perf_counter() - started
+        for lane, run in enumerate(group[:len(runs) - first]):
+            signals = {name: Signal(outputs[:, sl, lane].copy(), labels, units)
+                       for name, (sl, labels, units) in loop.signals.items()}
+            results.append(SimResult(run.W[:, 0].copy(), signals,
+                                     {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}))
+    return results
+
+
+def _scalar(run: PreparedRun, compiled: bool) -> SimResult:
+    """One run on the scalar fast path (the fallback of :func:`run_lanes`)."""
+    result, timing = run_closed_loop(run.loop, run.z0, run.W.copy(), compiled=compiled, guard=run.guard)
+    return SimResult(result.t, result.signals, {**run.meta, **timing})
