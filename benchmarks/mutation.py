@@ -1,0 +1,197 @@
+"""Mutation testing of uvsym's core with mutmut (on demand, never in CI): kill rate per module and every survivor.
+
+Run ``python benchmarks/mutation.py [--modules GLOB ...] [--max-children 1]`` (needs ``pip install -e .[mutation]``).
+The ``[tool.mutmut]`` section of pyproject.toml says what is mutated (``only_mutate``) and by which tests; this
+script copies the working tree (tracked and new files, not ignored ones) to a scratch folder, narrows
+``only_mutate`` to ``--modules`` (globs or paths under ``uvsym/``; default every configured module), runs
+``nice -n 15 mutmut run --max-children N`` there and writes ``benchmarks/results/mutation.json``:
+
+- ``modules``: per file, mutants ``total``, ``killed`` (failed a test, timed out or crashed), ``survived``,
+  ``equivalent`` (survivors listed in ``tests/mutation_equivalents.toml`` with a reason), ``no_tests`` (no
+  selected test reaches the code) and ``kill_rate`` = killed / (total - equivalent);
+- ``survivors``: name and diff of every survivor not justified as equivalent; ``stale_equivalents``: entries of
+  the equivalents file whose mutant no longer exists or no longer shows the recorded change;
+- ``started``, ``seconds``, ``modules_requested``, the mutmut version (``--merge`` keeps the other modules of
+  the last results, each with the ``started`` of its own run).
+
+tests/mutation_equivalents.toml lists ``[[equivalent]]`` tables: ``mutant`` (mutmut's name), ``change`` (a line
+the mutant's diff adds, so a renumbered mutant is not excused by mistake) and ``reason`` (one line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import fnmatch
+import importlib.metadata
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from datetime import datetime, timezone
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from common import finish  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results" / "mutation.json"
+EQUIVALENTS = ROOT / "tests" / "mutation_equivalents.toml"
+KILLED = {"killed", "timeout", "segfault", "caught by type check"}
+TARGET_KILL_RATE = 0.85
+
+
+def _config() -> dict:
+    return tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["mutmut"]
+
+
+def configured_modules(config: dict) -> list[str]:
+    """Every file that ``only_mutate`` names and ``do_not_mutate`` does not, as paths relative to the root."""
+    files = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "uvsym").rglob("*.py"))
+    return [f for f in files if any(fnmatch.fnmatch(f, p) for p in config["only_mutate"])
+            and not any(fnmatch.fnmatch(f, p) for p in config.get("do_not_mutate", []))]
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return json.dumps(value)
+
+
+def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str]) -> None:
+    """The working tree's files (tracked and untracked, ignored ones and ``without`` left out) in ``scratch``, with
+    ``only_mutate`` narrowed to ``modules`` and test files that do not exist dropped from the selection."""
+    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", "uvsym", "derivations",
+                             "tests"], capture_output=True, text=True, check=True).stdout.split()
+    for name in listed + ["pyproject.toml"]:
+        if (ROOT / name).is_file() and name not in without:
+            (scratch / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(ROOT / name, scratch / name)
+    narrowed = {**config, "only_mutate": modules,
+                "pytest_add_cli_args_test_selection": [t for t in config["pytest_add_cli_args_test_selection"]
+                                                       if (scratch / t).exists()]}
+    section = "[tool.mutmut]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in narrowed.items())
+    text = (scratch / "pyproject.toml").read_text()
+    text = re.sub(r"(?ms)^\[tool\.mutmut\]\n.*?(?=^\[)", lambda _: section + "\n", text)
+    (scratch / "pyproject.toml").write_text(text)
+
+
+def _equivalents() -> list[dict]:
+    if not EQUIVALENTS.exists():
+        return []
+    return tomllib.loads(EQUIVALENTS.read_text()).get("equivalent", [])
+
+
+def _outcomes(scratch: Path, modules: list[str]) -> dict[str, dict[str, str]]:
+    """module -> mutant name -> status, from the .meta files mutmut wrote in ``scratch/mutants``."""
+    from mutmut.stats import status_by_exit_code
+
+    out = {}
+    for module in modules:
+        meta = scratch / "mutants" / f"{module}.meta"
+        codes = json.loads(meta.read_text())["exit_code_by_key"] if meta.exists() else {}
+        out[module] = {name: status_by_exit_code[code] for name, code in codes.items()}
+    return out
+
+
+def _diff(scratch: Path, name: str) -> str:
+    shown = subprocess.run([str(Path(sys.executable).parent / "mutmut"), "show", name], cwd=scratch,
+                           capture_output=True, text=True)
+    return "\n".join(line for line in shown.stdout.splitlines() if line.startswith(("+", "-"))
+                     and not line.startswith(("+++", "---")))
+
+
+def _tally(scratch: Path, module: str, statuses: dict[str, str], equivalents: dict[str, dict],
+           started: str) -> tuple[dict, list[dict], set[str]]:
+    """(counts of one module, its unjustified survivors with their diffs, the equivalents that excused one)."""
+    survivors, excused = [], set()
+    for name in (n for n, s in statuses.items() if s in ("survived", "no tests")):
+        diff = _diff(scratch, name)
+        entry = equivalents.get(name)
+        if entry and entry["change"].strip() in diff:
+            excused.add(name)
+        else:
+            survivors.append({"mutant": name, "module": module, "status": statuses[name], "diff": diff})
+    count = {status: sum(s == status for s in statuses.values()) for status in set(statuses.values())}
+    killed = sum(n for status, n in count.items() if status in KILLED)
+    judged = killed + len(survivors) + count.get("suspicious", 0)  # not checked (an interrupted run) left out
+    return ({"started": started, "total": len(statuses), "killed": killed, "survived": len(survivors),
+             "equivalent": len(excused), "not_checked": count.get("not checked", 0),
+             "suspicious": count.get("suspicious", 0), "kill_rate": killed / judged if judged else None},
+            survivors, excused)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--modules", nargs="+", help="globs or paths of modules to mutate (default: all configured)")
+    parser.add_argument("--max-children", type=int, default=1, help="mutants tested at once (default 1: shared cores)")
+    parser.add_argument("--keep", type=Path, help="run in this folder and keep it (default: a temporary one)")
+    parser.add_argument("--without", nargs="+", default=[],
+                        help="test files to leave out (to measure what the other tests kill)")
+    parser.add_argument("--merge", action="store_true",
+                        help="keep the modules and survivors of the last results that this run does not measure")
+    parser.add_argument("--before", action="store_true",
+                        help="record this run as the baseline (key 'before') and leave the last results as they are")
+    args = parser.parse_args(argv)
+    config = _config()
+    available = configured_modules(config)
+    modules = available if not args.modules else [m for m in available if any(
+        fnmatch.fnmatch(m, p) or m == p for p in args.modules)]
+    if not modules:
+        parser.error(f"--modules matches none of the configured modules: {', '.join(available)}")
+    started, clock = datetime.now(timezone.utc).isoformat(timespec="seconds"), time.perf_counter()
+    scratch = args.keep or Path(tempfile.mkdtemp(prefix="uvsym-mutation-"))
+    try:
+        scratch.mkdir(parents=True, exist_ok=True)
+        _copy_tree(scratch, config, modules, args.without)
+        mutmut = str(Path(sys.executable).parent / "mutmut")
+        env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+        run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children)],
+                             cwd=scratch, env=env, capture_output=True, text=True)
+        (scratch / "mutmut-run.log").write_text(run.stdout + run.stderr)
+        seconds = time.perf_counter() - clock
+        equivalents = {e["mutant"]: e for e in _equivalents()}
+        per_module, survivors, justified = {}, [], set()
+        outcomes = _outcomes(scratch, modules)
+        for module, statuses in outcomes.items():
+            per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
+            survivors += left
+            justified |= excused
+    finally:
+        if args.keep is None:
+            shutil.rmtree(scratch, ignore_errors=True)
+    measured = {name for statuses in outcomes.values() for name in statuses}
+    prefixes = tuple(m[:-3].replace("/", ".") + "." for m in modules)
+    stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified)
+    saved = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    previous = saved.get("before", {}) if args.before else saved
+    if args.merge and previous:
+        per_module = {**{k: v for k, v in previous["modules"].items() if k not in per_module}, **per_module}
+        survivors = [s for s in previous["survivors"] if s["module"] not in outcomes] + survivors
+        stale = sorted(set(stale) | {n for n in previous.get("stale_equivalents", []) if not n.startswith(prefixes)})
+    rates = [m["kill_rate"] for m in per_module.values() if m["kill_rate"] is not None]
+    results = {"started": started, "seconds": seconds, "mutmut": importlib.metadata.version("mutmut"),
+               "max_children": args.max_children, "modules_requested": args.modules or ["(all configured)"],
+               "tests_left_out": args.without, "mutmut_exit_code": run.returncode, "mutants_measured": len(measured),
+               "modules": per_module, "lowest_kill_rate": min(rates) if rates else None, "survivors": survivors,
+               "stale_equivalents": stale}
+    for module, m in per_module.items():
+        rate = "-" if m["kill_rate"] is None else f"{100 * m['kill_rate']:.1f} %"
+        print(f"{module:<40} {m['killed']:>4} of {m['total']:<4} killed ({rate}), {m['survived']} survived, "
+              f"{m['equivalent']} equivalent, {m['not_checked']} not checked")
+    if args.before:
+        RESULTS.parent.mkdir(parents=True, exist_ok=True)
+        RESULTS.write_text(json.dumps({**saved, "before": results}, indent=2) + "\n")
+        print(f"wrote the baseline into {RESULTS}")
+    else:
+        finish({**results, "before": saved.get("before")}, {"lowest_kill_rate_min": TARGET_KILL_RATE}, RESULTS)
+    return 0 if run.returncode == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

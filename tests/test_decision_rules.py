@@ -1,0 +1,160 @@
+"""The decision rules of isolation and of the diagnosis supervisor on hand-made records.
+
+Isolation (Liu et al. 2014, sec. 2.2, as uvsym.observers.isolation states it): per channel, the observer with the
+smallest f_bar variance names the fault once that variance is below ``threshold`` and at most ``margin`` times every
+other observer's; the first sample where this holds is the decision time; an observer that settled at its no-fault
+value names no fault (healthy). The variances and means below are set by hand (powers of two, so that the margin
+boundary is exact), and the expected decision row follows from the rule, not from the code. The supervisor's
+timing is read on a stub isolation result: the correction comes back from the very update that identifies a
+fault, and a channel decided healthy clears the actuators that act only on healthy channels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvsym.models.registry import vehicle
+from uvsym.observers.isolation import ChannelDecision, IsolationResult, IsolationSettings, Isolator
+from uvsym.observers.supervisor import FaultDiagnosis
+
+T = np.arange(6) * 0.1  # s
+V = 2.0**-17  # a variance well below the default threshold (1e-4)
+
+
+def decide(records: dict[str, dict], settings=None, tau_d=5.0):
+    """The decision on one channel "X" from per-observer records: kind -> {"var", "mean", "visible"} (each a
+    scalar or a (6,) sequence over T)."""
+    isolator = Isolator({kind: (None, None) for kind in records}, ("X",), settings or IsolationSettings())
+    isolator.t, isolator.tau_d = T, np.full((len(T), 1), tau_d)
+    for kind, record in records.items():
+        isolator.variance[kind] = np.broadcast_to(np.asarray(record["var"], float), T.shape)[:, None].copy()
+        isolator.mean[kind] = np.broadcast_to(np.asarray(record["mean"], float), T.shape)[:, None].copy()
+        isolator.visible[kind] = np.broadcast_to(np.asarray(record.get("visible", True)), T.shape)[:, None].copy()
+    isolator._decide(0)
+    return isolator.decisions.get("X")
+
+
+def test_the_winner_must_beat_every_other_variance_by_the_margin_and_the_first_such_sample_decides():
+    # margin 1/4: V <= (1/4) var_p from var_p = 4 V on (row 2, exactly at the bound), and at every later row
+    records = {"bias": {"var": V, "mean": 2.0}, "proportional": {"var": [2 * V, 3 * V, 4 * V, 8 * V, 16 * V, 16 * V],
+                                                                  "mean": 1.3}}
+    decision = decide(records, IsolationSettings(margin=0.25))
+    assert decision == ChannelDecision("X", "bias", T[2], 2.0, V)
+    assert decide(records, IsolationSettings(margin=0.125)).time_s == T[3]  # needs var_p >= 8 V
+    assert decide(records, IsolationSettings(margin=0.0625)).time_s == T[4]
+    assert decide(records, IsolationSettings(margin=0.01)) is None  # never separated enough
+
+
+def test_the_winner_must_be_below_the_threshold():
+    records = {"bias": {"var": [4e-4, 2e-4, 1e-4, 5e-5, 5e-5, 5e-5], "mean": 2.0},
+               "proportional": {"var": 1.0, "mean": 1.3}}
+    assert decide(records).time_s == T[3]  # 1e-4 is not below the threshold 1e-4
+
+
+def test_the_smallest_variance_names_the_kind_and_its_mean_and_variance_are_reported():
+    records = {"bias": {"var": 1e-3, "mean": 7.0}, "proportional": {"var": [1e-3, 1e-3, V, V, V, V], "mean": 0.6}}
+    assert decide(records) == ChannelDecision("X", "proportional", T[2], 0.6, V)
+
+
+def test_a_winner_settled_at_its_no_fault_value_names_no_fault():
+    """The bias observer wins (small variance, other one large) but its f_bar is 0.01 <= healthy_tolerance."""
+    records = {"bias": {"var": V, "mean": 0.01}, "proportional": {"var": 1e-2, "mean": 1.3}}
+    decision = decide(records)
+    assert decision.kind == "healthy" and decision.time_s == T[0] and decision.f_bar == 0.01
+
+
+def test_every_observer_settled_at_its_no_fault_value_is_healthy_without_a_margin():
+    """Both variances small and equal (no winner by the margin); both means at the no-fault values from row 1."""
+    records = {"bias": {"var": V, "mean": [0.2, 0.04, 0.04, 0.04, 0.04, 0.04]}, "proportional": {"var": V,
+                                                                                              "mean": 1.005}}
+    decision = decide(records)
+    assert decision.kind == "healthy" and decision.time_s == T[1]
+
+
+def test_the_proportional_observer_has_its_own_tolerance():
+    """|1.02 - 1| = 0.02 is within healthy_tolerance (0.05) but not healthy_tolerance_p (0.01); equal variances:
+    neither a fault (no margin) nor healthy (the proportional observer is not at its no-fault value)."""
+    records = {"bias": {"var": V, "mean": 0.02}, "proportional": {"var": V, "mean": 1.02}}
+    assert decide(records) is None
+    records["proportional"]["mean"] = 1.009
+    assert decide(records).kind == "healthy"
+    records["bias"]["mean"] = 0.06  # beyond healthy_tolerance
+    assert decide(records) is None
+
+
+def test_a_constant_fault_is_healthy_at_the_desired_action():
+    """The constant kind's no-fault value is tau_d (here 5): a channel whose stuck value equals it is healthy."""
+    records = {"constant": {"var": V, "mean": 5.0}, "bias": {"var": V, "mean": 0.0}}
+    assert decide(records, tau_d=5.0).kind == "healthy"
+    records = {"constant": {"var": V, "mean": 3.0}, "bias": {"var": 1e-2, "mean": -2.0}}
+    assert decide(records, tau_d=5.0).kind == "constant"
+
+
+def test_an_observer_that_never_saw_the_channel_does_not_vote_but_one_that_did_must():
+    unseen = {"bias": {"var": V, "mean": 2.0}, "proportional": {"var": np.nan, "mean": np.nan, "visible": False}}
+    assert decide(unseen).kind == "bias"  # no other variance: the margin holds against none
+    seen_once = {"bias": {"var": V, "mean": 2.0},
+                 "proportional": {"var": np.nan, "mean": np.nan, "visible": [True, False, False, False, False, False]}}
+    assert decide(seen_once) is None  # it saw the channel and has no variance yet: no vote, no decision
+    healthy = {"bias": {"var": V, "mean": 0.0}, "proportional": {"var": np.nan, "mean": np.nan, "visible": False}}
+    assert decide(healthy).kind == "healthy"
+
+
+def test_a_decision_is_kept_once_made():
+    isolator = Isolator({"bias": (None, None)}, ("X",))
+    isolator.decisions["X"] = ChannelDecision("X", "bias", 0.1, 2.0, V)
+    isolator.t, isolator.tau_d = T, np.zeros((6, 1))
+    isolator.variance["bias"], isolator.mean["bias"] = np.full((6, 1), V), np.zeros((6, 1))
+    isolator.visible["bias"] = np.ones((6, 1), bool)
+    isolator._decide(0)  # now it would be healthy
+    assert isolator.decisions["X"].kind == "bias"
+
+
+class StubIsolator:
+    """Isolation that decides the channels given per update call (each decision's time is the call's last t)."""
+
+    def __init__(self, schedule: list[dict[str, tuple[str, float]]]):
+        self.observers, self.schedule, self.decisions, self.t = {"bias": None}, list(schedule), {}, np.zeros(0)
+
+    def update(self, t, f_hat, tau_d):
+        self.t = np.concatenate([self.t, t])
+        for channel, (kind, f_bar) in self.schedule.pop(0).items():
+            self.decisions[channel] = ChannelDecision(channel, kind, float(t[-1]), f_bar, 0.0)
+        return IsolationResult(self.t, (), {}, {}, dict(self.decisions))
+
+
+def _signals(k: int) -> dict[str, np.ndarray]:
+    """k samples of the docking AUV at 1.5 m/s with 20 N of desired thrust (the rudders at 0)."""
+    y = np.tile(np.r_[np.zeros(6), 1.5, np.zeros(5)], (k, 1))
+    return {"y": y, "u_expected": np.tile([20.0, 0.0, 0.0, 0.0], (k, 1)), "f_hat/bias": np.zeros((k, 6)),
+            "tau_desired": np.tile([20.0, 0, 0, 0, 0, 0], (k, 1))}
+
+
+def test_the_correction_comes_back_from_the_update_that_identifies_the_fault():
+    """At 1.5 m/s the X row of B is (1, 0, 0, 0): a bias of 13 N on channel X is a 13 N thruster bias, corrected
+    by subtracting 13 N from its command (S = I, o = (-13, 0, 0, 0)). Channels Y, Z, K, M, N found healthy clear
+    the elevator and both rudders (they act on those channels only). Until every channel is decided, B's decided
+    rows cannot separate the actuators: nothing is identified."""
+    healthy = {c: ("healthy", 0.0) for c in ("Y", "Z", "K", "M", "N")}
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.3)
+    diagnosis.isolator = StubIsolator([{}, healthy, {"X": ("bias", 13.0)}, {}])
+    assert diagnosis.update(T[:2], _signals(2)) is None
+    assert diagnosis.update(T[2:4], _signals(2)) is None  # rudders and elevator cleared, the thruster undecided
+    assert diagnosis.healthy == {"delta_e": T[3], "delta_ru": T[3], "delta_rd": T[3]} and not diagnosis.decided
+    assert np.isnan(diagnosis.isolation_time_s)
+    correction = diagnosis.update(T[4:], _signals(2))
+    assert correction is not None
+    np.testing.assert_allclose(correction.S, np.eye(4), atol=1e-12)
+    np.testing.assert_allclose(correction.o, [-13.0, 0.0, 0.0, 0.0], atol=1e-9)
+    estimate = diagnosis.identified["X"]
+    assert (estimate.kind, estimate.time_s) == ("bias", T[5]) and estimate.value == pytest.approx(13.0, abs=1e-9)
+    assert diagnosis.decided and diagnosis.isolation_time_s == T[5]
+    assert diagnosis.update(T[5:] + 0.1, _signals(1)) is None  # nothing new identified: no new correction
+
+
+def test_without_correction_the_supervisor_only_identifies():
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.3, correct=False)
+    diagnosis.isolator = StubIsolator([{"X": ("bias", -4.0)} | {c: ("healthy", 0.0) for c in "YZKMN"}])
+    assert diagnosis.update(T[:3], _signals(3)) is None
+    assert diagnosis.identified["X"].value == pytest.approx(-4.0, abs=1e-9)
