@@ -1,0 +1,352 @@
+"""uvsym campaign: dotted paths and grid expansion, bad input, metrics from hand-written event logs,
+tiny real campaigns on local processes and on a Dask LocalCluster, resume after the driver is
+killed, and a worker process that dies during a run."""
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+import uuid
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from uvsym.campaign import event_metrics, load_campaign, run_campaign, run_metrics, truth
+from uvsym.campaign.dotted import parse_path, set_path
+from uvsym.cli import main
+from uvsym.errors import CampaignError, CampaignSizeError, ExecutorError, PathError
+from uvsym.sim.result import Signal, SimResult
+from uvsym.sim.scenario import load_scenario
+
+GRID = """
+name = "grid"
+[[case]]
+name = "thruster"
+scenario = "docking_faults"
+set = { "duration" = 30.0 }
+[case.grid]
+"faults" = [[]]
+"faults[0].actuator" = ["X"]
+"faults[0]" = [{kind = "bias", value = 10.0}, {kind = "proportional", value = 0.6}]
+"faults[0].onset" = [5.0, 20.0]
+"seed" = [1, 2]
+"""
+
+# two 2 s runs, interpreted (a short run is cheaper than compiling its loop), one process, a chunk per run
+TINY = """
+name = "tiny"
+metrics = "{hooks}:{function}"
+[executor]
+workers = 1
+chunk_size = 1
+[simulation]
+compiled = false
+[[case]]
+name = "thruster"
+scenario = "docking_faults"
+set = {{ "duration" = 2.0, "faults" = [{{ actuator = "X", kind = "bias", value = 10.0, onset = 1.0 }}] }}
+[case.grid]
+"seed" = {seeds}
+"""
+
+HOOKS = '''
+import os, time
+from pathlib import Path
+
+LOG = Path(__file__).with_name("executed.log")
+
+
+def _log(scenario):
+    with open(LOG, "a") as log:
+        log.write(f"{scenario.seed}\\n")
+
+
+def metrics(scenario, result, events):
+    _log(scenario)
+    return {"final_u_mps": float(result["x"]["u"][-1])}
+
+
+def slow(scenario, result, events):
+    time.sleep(1.0)
+    return metrics(scenario, result, events)
+
+
+def killer(scenario, result, events):
+    if scenario.seed == 2:
+        os._exit(3)
+    return metrics(scenario, result, events)
+'''
+
+
+def _write(folder, text: str, name: str = "campaign.toml"):
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
+def _tiny(folder, function: str = "metrics", seeds=(1, 2)):
+    """A TINY campaign file in ``folder`` with its own hook module (a fresh name: the driver imports it)."""
+    hooks = f"hooks_{uuid.uuid4().hex[:8]}"
+    (folder / f"{hooks}.py").write_text(HOOKS)
+    return _write(folder, TINY.format(hooks=hooks, function=function, seeds=list(seeds)))
+
+
+def _executed(folder) -> list[int]:
+    log = folder / "executed.log"
+    return [int(line) for line in log.read_text().split()] if log.exists() else []
+
+
+# dotted paths and expansion
+
+
+def test_dotted_paths_create_merge_and_replace():
+    assert parse_path("faults[0].onset") == ("faults", 0, "onset")
+    data = {"faults": [{"actuator": "X", "kind": "bias", "value": 13.0}], "duration": 90.0}
+    set_path(data, "current.speed", 0.1)                 # missing table made
+    set_path(data, "faults", [])                         # a value replaces
+    set_path(data, "faults[0].actuator", "delta_ru")     # the missing entry made as a table
+    set_path(data, "faults[0]", {"kind": "proportional", "value": 0.6})  # a table merges
+    assert data == {"faults": [{"actuator": "delta_ru", "kind": "proportional", "value": 0.6}],
+                    "duration": 90.0, "current": {"speed": 0.1}}
+    with pytest.raises(CampaignError, match=r"faults\[2\].*1 entries.*gap"):
+        set_path(data, "faults[2].onset", 1.0)
+    with pytest.raises(CampaignError, match="duration.*float, not a table"):
+        set_path(data, "duration.x", 1.0)
+    with pytest.raises(CampaignError, match="malformed"):
+        parse_path("faults..onset")
+
+
+def test_grid_is_the_product_of_the_axes_in_file_order(tmp_path):
+    campaign = load_campaign(_write(tmp_path, GRID))
+    assert len(campaign.runs) == 1 * 1 * 2 * 2 * 2
+    # the last axis varies fastest: run 0 bias/5 s/seed 1, run 1 seed 2, run 2 onset 20 s, run 4 proportional
+    expected = [("bias", 10.0, 5.0, 1), ("bias", 10.0, 5.0, 2), ("bias", 10.0, 20.0, 1), ("bias", 10.0, 20.0, 2),
+                ("proportional", 0.6, 5.0, 1), ("proportional", 0.6, 5.0, 2), ("proportional", 0.6, 20.0, 1),
+                ("proportional", 0.6, 20.0, 2)]
+    for run, (kind, value, onset, seed) in zip(campaign.runs, expected):
+        assert run.scenario["faults"] == [{"actuator": "X", "kind": kind, "value": value, "onset": onset}]
+        assert run.scenario["seed"] == seed and run.scenario["duration"] == 30.0
+        assert run.fields == {"faults": [], "faults[0].actuator": "X", "faults[0].kind": kind,
+                              "faults[0].value": value, "faults[0].onset": onset, "seed": seed}
+    assert len({run.id for run in campaign.runs}) == 8
+    assert [r.id for r in load_campaign(tmp_path / "campaign.toml").runs] == [r.id for r in campaign.runs]
+
+
+def test_monte_carlo_draws_are_reproducible_and_in_range(tmp_path):
+    draws = """
+[case.monte_carlo]
+runs = 3
+seed = {seed}
+"current.speed" = {{ uniform = [0.0, 0.2] }}
+"faults[0].onset" = {{ choice = [5.0, 10.0, 15.0] }}
+"""
+    first = load_campaign(_write(tmp_path, GRID + draws.format(seed=0), "a.toml"))
+    again = load_campaign(_write(tmp_path, GRID + draws.format(seed=0), "b.toml"))
+    other = load_campaign(_write(tmp_path, GRID + draws.format(seed=1), "c.toml"))
+    assert len(first.runs) == 8 * 3
+    speeds = [run.scenario["current"]["speed"] for run in first.runs]
+    assert all(0.0 <= s <= 0.2 for s in speeds) and len(set(speeds)) == 24
+    assert {run.scenario["faults"][0]["onset"] for run in first.runs} <= {5.0, 10.0, 15.0}
+    assert [r.scenario for r in again.runs] == [r.scenario for r in first.runs]
+    assert speeds != [run.scenario["current"]["speed"] for run in other.runs]
+    assert [run.draw for run in first.runs[:4]] == [0, 1, 2, 0]
+
+
+def test_the_example_campaign_is_valid(capsys):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "campaign_docking.toml"
+    assert main(["campaign", str(example), "--dry-run"]) == 0
+    assert "20 runs in 3 cases" in capsys.readouterr().out
+
+
+# bad input: typed errors naming the field or the address, before anything runs
+
+
+def test_bad_campaigns_are_refused_naming_the_field(tmp_path):
+    with pytest.raises(CampaignError, match="grid axis 'seed' is an empty list"):
+        load_campaign(_write(tmp_path, GRID.replace('"seed" = [1, 2]', '"seed" = []')))
+    with pytest.raises(CampaignError, match=r"durration: unknown field \(did you mean 'duration'\?\)"):
+        load_campaign(_write(tmp_path, GRID + '"durration" = [10.0]\n'))
+    with pytest.raises(CampaignError, match=r"current.sped: unknown field \(did you mean 'speed'\?\)"):
+        load_campaign(_write(tmp_path, GRID + '"current.sped" = [0.1]\n'))
+    with pytest.raises(CampaignError, match=r"case\[0\].gird: unknown field"):
+        load_campaign(_write(tmp_path, GRID.replace("[case.grid]", "[case.gird]")))
+    with pytest.raises(CampaignError, match="monte_carlo field 'current.speed'.*lo 0.3 > hi 0.1"):
+        load_campaign(_write(tmp_path, GRID + '[case.monte_carlo]\nruns = 2\n"current.speed" = '
+                                              '{ uniform = [0.3, 0.1] }\n'))
+    with pytest.raises(CampaignSizeError, match="8 runs, more than max_runs = 5.*--yes"):
+        load_campaign(_write(tmp_path, "max_runs = 5\n" + GRID))
+    assert len(load_campaign(tmp_path / "campaign.toml", confirm=True).runs) == 8
+
+
+def test_the_command_reports_bad_input_and_size(tmp_path, capsys):
+    path = _write(tmp_path, GRID + '"durration" = [10.0]\n')
+    assert main(["campaign", str(path), "--out", str(tmp_path / "out")]) == 2
+    assert "did you mean 'duration'" in capsys.readouterr().err
+    path = _write(tmp_path, "max_runs = 5\n" + GRID)
+    assert main(["campaign", str(path), "--dry-run"]) == 2
+    assert "more than max_runs = 5" in capsys.readouterr().err
+    assert main(["campaign", str(path), "--dry-run", "--yes"]) == 0
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_unreachable_scheduler_is_named_before_any_run(tmp_path):
+    pytest.importorskip("distributed", reason="dask.distributed is not installed (pip install 'uvsym[cluster]')")
+    campaign = load_campaign(_write(tmp_path, GRID + "[executor]\ntimeout_s = 0.5\n"))
+    started = time.perf_counter()
+    with pytest.raises(ExecutorError, match="tcp://127.0.0.1:1"):
+        run_campaign(campaign, tmp_path / "out", scheduler="tcp://127.0.0.1:1")
+    assert time.perf_counter() - started < 10.0
+    assert not (tmp_path / "out").exists()
+
+
+def test_without_dask_the_error_names_the_extra(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed now fails
+    campaign = load_campaign(_write(tmp_path, GRID))
+    with pytest.raises(ExecutorError, match=r"uvsym\[cluster\]"):
+        run_campaign(campaign, tmp_path / "out", executor="dask")
+
+
+def test_a_folder_of_other_files_is_refused(tmp_path):
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "notes.txt").write_text("mine")
+    with pytest.raises(PathError, match="notes.txt"):
+        run_campaign(load_campaign(_write(tmp_path, GRID)), tmp_path / "out")
+
+
+# metrics from hand-written event logs
+
+TRUTH = {"n_faults": 1, "true_actuator": "X", "true_sensor": None, "true_kind": "bias", "true_value": 10.0,
+         "onset_s": 5.0, "end_s": None}
+
+
+def _event(t, event, actuator=None, kind=None, value=None):
+    return {"t": t, "event": event, "actuator": actuator, "kind": kind, "value": value}
+
+
+def test_metrics_of_a_hand_written_event_log():
+    events = [_event(2.0, "detected"),                           # before the onset: a false alarm
+              _event(3.0, "cleared"),
+              _event(5.8, "detected"),                           # detection delay 0.8 s
+              _event(6.5, "isolated", "delta_ru", "bias"),       # wrong, then cleared
+              _event(7.0, "cleared", "delta_ru"),
+              _event(7.5, "isolated", "X", "bias"),              # isolation delay 2.5 s
+              _event(9.0, "identified", "X", "bias", 9.5),
+              _event(12.0, "identified", "X", "bias", 10.4),     # the last: 4 % too large
+              _event(13.0, "ambiguous", "X|delta_ru")]
+    metrics = event_metrics(TRUTH, events[::-1])                # order of the list does not matter
+    assert metrics == {"events": 9, "detected": True, "detection_delay_s": pytest.approx(0.8),
+                       "isolated_actuator": "X", "isolated_kind": "bias", "isolation_delay_s": pytest.approx(2.5),
+                       "identified_value": 10.4, "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
+                       "ambiguous": True, "unexcited": False}
+
+
+def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
+    truth_row = TRUTH | {"end_s": 20.0}
+    events = [_event(6.0, "detected"), _event(21.0, "identified", "X", None, 3.0),  # before the clearing: its own
+              _event(22.0, "cleared"), _event(30.0, "detected"), _event(31.0, "unexcited")]
+    metrics = event_metrics(truth_row, events)
+    assert metrics["false_alarms"] == 1 and metrics["detection_delay_s"] == pytest.approx(1.0)
+    assert metrics["identified_value"] == 3.0 and metrics["size_error_rel"] == pytest.approx(0.7)
+    assert metrics["isolated_actuator"] is None and metrics["unexcited"] is True
+    healthy = {key: None for key in TRUTH} | {"n_faults": 0}
+    metrics = event_metrics(healthy, [_event(3.0, "detected"), _event(4.0, "isolated", "X", "bias")])
+    assert metrics["false_alarms"] == 2 and metrics["detected"] is False and metrics["detection_delay_s"] is None
+    assert metrics["isolated_actuator"] == "X"
+
+
+def test_truth_and_path_error_of_a_run():
+    # docking_faults: X bias 13 N, then both rudders at 0.8, all from 0 s: the first listed is the run's fault
+    scenario = load_scenario("docking_faults")
+    assert truth(scenario) == {"n_faults": 3, "true_actuator": "X", "true_sensor": None, "true_kind": "bias",
+                               "true_value": 13.0, "onset_s": 0.0, "end_s": None}
+    result = SimResult(np.array([0.0, 1.0]), {"reference": Signal(np.array([[0.0, 3.0], [0.0, 4.0]]),
+                                                                  ("psi_ref", "cross_track"), ("rad", "m"))})
+    assert run_metrics(scenario, result, [])["path_error_rms_m"] == pytest.approx(math.sqrt((9 + 16) / 2))
+
+
+# real campaigns
+
+
+@pytest.fixture(scope="module")
+def local_run(tmp_path_factory):
+    """The tiny campaign on the local executor: (folder, campaign, table)."""
+    folder = tmp_path_factory.mktemp("local")
+    campaign = load_campaign(_tiny(folder))
+    return folder, campaign, run_campaign(campaign, folder / "out")
+
+
+def test_a_tiny_campaign_on_local_processes(local_run):
+    folder, campaign, table = local_run
+    rows = table.to_pylist()
+    assert [r["run_id"] for r in rows] == [r.id for r in campaign.runs] and [r["seed"] for r in rows] == [1, 2]
+    assert all(r["status"] == "ok" and r["true_actuator"] == "X" and r["onset_s"] == 1.0 for r in rows)
+    assert all(r["final_u_mps"] > 1.0 for r in rows)  # the hook's column: near the 1.5 m/s reference
+    # the path error is the RMS cross-track error of the same run made directly
+    from uvsym.sim.scenario import parse_scenario
+    from uvsym.sim.simulation import simulate_scenario
+
+    direct = simulate_scenario(parse_scenario(campaign.runs[0].scenario), compiled=False)
+    cross = direct["reference"]["cross_track"]
+    assert rows[0]["path_error_rms_m"] == pytest.approx(float(np.sqrt(np.sum(cross ** 2) / cross.size)), rel=1e-9)
+    out = folder / "out"
+    assert len(list((out / "chunks").glob("chunk-*.parquet"))) == 2
+    assert pq.read_table(out / "results.parquet").to_pylist() == rows
+    assert (out / "results.csv").read_text().count("\n") == 3  # header and two rows
+    summary = json.loads((out / "summary.json").read_text())
+    assert (summary["runs"], summary["ok"], summary["fault_runs"]) == (2, 2, 2)
+    assert summary["confusion"] == {"X": {"none": 2}}
+    assert (out / "report.html").read_text().count("data:image/svg+xml") == 3
+    assert sorted(_executed(folder)) == [1, 2]
+    again = run_campaign(campaign, out)  # everything finished: nothing runs again
+    assert again.to_pylist() == rows and sorted(_executed(folder)) == [1, 2]
+
+
+def test_the_same_campaign_on_a_dask_local_cluster(local_run, tmp_path):
+    distributed = pytest.importorskip("distributed", reason="dask.distributed is not installed "
+                                                            "(pip install 'uvsym[cluster]')")
+    _, campaign, local = local_run
+    campaign = load_campaign(_tiny(tmp_path))
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                                  dashboard_address=None) as cluster:
+        table = run_campaign(campaign, tmp_path / "out", scheduler=cluster.scheduler_address)
+    rows, expected = table.to_pylist(), local.to_pylist()
+    assert [r["run_id"] for r in rows] == [r["run_id"] for r in expected]
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    assert [r["path_error_rms_m"] for r in rows] == pytest.approx([r["path_error_rms_m"] for r in expected])
+    assert sorted(_executed(tmp_path)) == [1, 2]
+
+
+def test_a_killed_driver_resumes_without_redoing_finished_runs(tmp_path):
+    path = _tiny(tmp_path, "slow", seeds=(1, 2, 3, 4))
+    out = tmp_path / "out"
+    driver = subprocess.Popen([sys.executable, "-m", "uvsym.cli", "campaign", str(path), "--out", str(out)],
+                              start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not list(out.glob("chunks/chunk-*.parquet")) and driver.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(driver.pid, signal.SIGKILL)  # the driver and its worker process
+    driver.wait()
+    finished = {seed for chunk in out.glob("chunks/chunk-*.parquet")
+                for seed in pq.read_table(chunk)["seed"].to_pylist()}
+    assert 1 <= len(finished) < 4, "the kill should come after the first chunk and before the last"
+    assert main(["campaign", str(path), "--out", str(out)]) == 0
+    rows = pq.read_table(out / "results.parquet").to_pylist()
+    assert sorted(r["seed"] for r in rows) == [1, 2, 3, 4] and all(r["status"] == "ok" for r in rows)
+    executed = _executed(tmp_path)
+    assert all(executed.count(seed) == 1 for seed in finished)  # finished runs were not redone
+    assert len(executed) <= 4 + 1  # at most the run in flight at the kill ran twice
+
+
+def test_a_worker_that_dies_gives_an_error_row_and_the_others_finish(tmp_path):
+    campaign = load_campaign(_tiny(tmp_path, "killer", seeds=(1, 2, 3)))
+    rows = run_campaign(campaign, tmp_path / "out").to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "error", "ok"]
+    assert rows[1]["error"].startswith("WorkerDied") and "exit code 3" in rows[1]["error"]
+    assert rows[1]["true_actuator"] == "X"  # truth is known without the run
+    assert sorted(_executed(tmp_path)) == [1, 3]
