@@ -87,6 +87,11 @@ class SimResult:
                 raise SimulationError(f"signal {name!r} must be a Signal with one row per time ({t.size})")
         object.__setattr__(self, "t", t)
 
+    @property
+    def events(self) -> list[dict]:
+        """The diagnosis's decision log (:mod:`uvsym.diagnosis.events`), empty for a run without one."""
+        return list(self.meta.get("events", []))
+
     def __getitem__(self, name: str) -> Signal:
         if name not in self.signals:
             raise UnknownNameError(f"no signal {name!r}; signals: {', '.join(self.signals)}")

@@ -16,7 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
-from uvsym.errors import FaultError, KinematicsError, ModelError, ObserverError, ScenarioError, UnknownNameError
+from uvsym.diagnosis.settings import DiagnosisSettings
+from uvsym.errors import (
+    DiagnosisError,
+    FaultError,
+    KinematicsError,
+    ModelError,
+    ObserverError,
+    ScenarioError,
+    UnknownNameError,
+)
 from uvsym.faults import ACTUATOR_KINDS, PROFILES, SENSOR_KINDS, ActuatorFault, Profile, SensorFault, actuator_kind
 from uvsym.kinematics import Tzyx
 from uvsym.models.model import Model
@@ -66,6 +75,7 @@ class Scenario:
     sensor_faults: tuple[SensorFault, ...]
     observers: tuple[ObserverSpec, ...]
     current_variation: tuple[float, float] = (0.0, 10.0)
+    diagnosis: DiagnosisSettings | None = None
 
 
 def shipped_scenarios() -> dict[str, Path]:
@@ -148,11 +158,13 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
     controller = _controller(top.table("controller"), model)
     actuator_faults, sensor_faults = _faults(top.tables("faults"), model, duration)
     observers = _observers(top.tables("observers"), model)
+    diagnosis = _diagnosis(top.table("diagnosis"), model, observers, sensor_faults)
     top.done()
     return Scenario(name=name, description=description, model=model, duration=duration, step=step, seed=seed,
                     eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c),
                     current_variation=variation, controller=controller,
-                    actuator_faults=actuator_faults, sensor_faults=sensor_faults, observers=observers)
+                    actuator_faults=actuator_faults, sensor_faults=sensor_faults, observers=observers,
+                    diagnosis=diagnosis)
 
 
 def _loop(fields: _Fields | None) -> Loop | None:
@@ -283,6 +295,53 @@ def _observers(items: list[_Fields], model: Model) -> tuple[ObserverSpec, ...]:
         fields.done()
         specs[kind] = (fields.path, spec)
     return tuple(spec for _, spec in specs.values())
+
+
+def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSpec, ...],
+               sensor_faults: tuple[SensorFault, ...]) -> DiagnosisSettings | None:
+    """The continuous actuator diagnosis (:class:`~uvsym.diagnosis.DiagnosisSettings`), or None
+    without a [diagnosis] table. Sensor noise defaults to the scenario's own noise faults that act
+    for the whole run (the sensors' specification)."""
+    if fields is None:
+        return None
+    defaults = DiagnosisSettings()
+    name = fields.text("observer", defaults.observer, choices=("bias",))
+    if name not in [observer.kind for observer in observers]:
+        raise ScenarioError("diagnosis.observer: the diagnosis reads the bias observer's estimate, and the scenario "
+                            "runs none; add [[observers]] with kind = \"bias\"")
+    lists = {}
+    for key, known in (("kinds", ACTUATOR_KINDS), ("actuators", model.input_labels)):
+        value = fields.raw(key, list(getattr(defaults, key)), "list of strings", "one of " + ", ".join(known))
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise ScenarioError(f"diagnosis.{key}: expected a list of names, got {value!r}")
+        for item in value:
+            if item not in known:
+                near = difflib.get_close_matches(item, list(known), n=1)
+                raise ScenarioError(f"diagnosis.{key}: unknown name {item!r}" + (f" (did you mean {near[0]!r}?)"
+                                    if near else "") + f"; known: {', '.join(known)}")
+        lists[key] = tuple(value)
+    numbers = {key: fields.number(key, getattr(defaults, key), positive=True)
+               for key in ("window_s", "min_window_s", "period_s", "false_alarm_rate", "isolation_error_rate",
+                           "resolution", "floor")}
+    confirm = fields.raw("confirm", defaults.confirm, "integer", ">= 1 (decisions)")
+    correct = fields.raw("correct", defaults.correct, "boolean", "feed identified faults back as a correction")
+    noise_fields = fields.table("noise")
+    fields.describe("noise.<channel>", "number", "standard deviation of a measured channel's noise",
+                    "the scenario's noise faults")
+    if noise_fields is None:
+        noise = {model.state_labels[f.channel]: f.value for f in sensor_faults
+                 if f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end)}
+    else:
+        noise = {channel: noise_fields.number(channel, minimum=0.0) for channel in list(noise_fields.data)}
+        for channel in noise:
+            if channel not in model.state_labels:
+                raise ScenarioError(f"diagnosis.noise.{channel}: unknown measured channel; known: "
+                                    f"{', '.join(model.state_labels)}")
+    fields.done()
+    try:
+        return DiagnosisSettings(observer=name, confirm=confirm, correct=correct, noise=noise, **lists, **numbers)
+    except DiagnosisError as exc:
+        raise ScenarioError(str(exc)) from None
 
 
 def _check_size(duration: float, step: float, model: Model, n_observers: int) -> None:

@@ -1,0 +1,137 @@
+"""Least-squares fits of actuator-fault hypotheses over one window (generalised likelihood ratios).
+
+With the residual whitened by its noise level per channel, every statistic below is a sum of
+squares in units of the noise variance: under a true hypothesis with white Gaussian noise, the
+drop ``J_model - J_candidate`` of one added parameter is chi-square with one degree of freedom
+(a generalised likelihood ratio, Basseville and Nikiforov 1993, ch. 4). The model's faults (already
+decided) and the filter's free response (:class:`~uvsym.diagnosis.regressors.RegressorBank`) are
+fitted jointly in every window.
+
+Every vector involved is a combination of a few columns -- the free response, the residual and
+each actuator's two filtered series -- so one Gram matrix of those columns gives every fit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from uvsym.diagnosis.regressors import RegressorBank
+from uvsym.faults import ActuatorKind
+
+__all__ = ["Hypothesis", "WindowFit", "fit_window"]
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    """Actuator index a, fault kind, and the sample from which it acts (0: the whole record);
+    ``at``: a size to linearise the vehicle's exact force model at (None: the first-order columns
+    ``F[B_a]``, ``F[B_a v]``, linear in the size)."""
+
+    actuator: int
+    kind: ActuatorKind
+    onset: int = 0
+    at: float | None = None
+
+
+@dataclass(frozen=True)
+class WindowFit:
+    """One window's verdicts. J_model: residual sum of squares with the model's faults fitted;
+    theta_model: (len(model),) their sizes; removal: (len(model),) the rise of J when each is
+    dropped; power: (len(model),) the J that each fault at ``values`` adds to a healthy record;
+    glr, theta, info: (len(candidates),) ``J_model - J`` per added candidate, its size, and the
+    information ``|P phi|^2`` (1 / variance of the size)."""
+
+    J_model: float
+    theta_model: np.ndarray
+    removal: np.ndarray
+    power: np.ndarray
+    glr: np.ndarray
+    theta: np.ndarray
+    info: np.ndarray
+
+
+class _Columns:
+    """The window's column matrix Z = [free response | residual | F[B_a], F[B_a v] per (a, onset)]."""
+
+    def __init__(self, bank: RegressorBank, rows: np.ndarray, transient: np.ndarray, hypotheses: list[Hypothesis]):
+        self.n_t = transient.shape[1]
+        blocks = [transient, (bank.r[rows] / bank.sigma).reshape(-1, 1)]
+        self.index: dict[tuple, int] = {}
+        for h in hypotheses:
+            key = self._key(h, rows[0])
+            if key not in self.index:
+                self.index[key] = self.n_t + 1 + 2 * len(self.index)
+                if h.at is None:
+                    pair = (bank.gated(bank.G[:, h.actuator], rows, h.onset),
+                            bank.gated(bank.H[:, h.actuator], rows, h.onset))
+                else:
+                    pair = bank.exact(rows, h.actuator, h.kind, h.at, h.onset)
+                blocks += [(column / bank.sigma).reshape(-1, 1) for column in pair]
+        self.rows0 = rows[0]
+        Z = np.hstack(blocks)
+        self.S = Z.T @ Z
+        self.size = Z.shape[1]
+
+    @staticmethod
+    def _key(h: Hypothesis, first: int) -> tuple:
+        onset = h.onset if first < h.onset else 0
+        return (h.actuator, onset) if h.at is None else (h.actuator, onset, h.kind.name, h.at)
+
+    def unit(self, column: int) -> np.ndarray:
+        w = np.zeros(self.size)
+        w[column] = 1.0
+        return w
+
+    def hypothesis(self, h: Hypothesis) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (c, phi) over Z with ``r = c + f phi`` under h (module docstring of regressors)."""
+        j = self.index[self._key(h, self.rows0)]
+        c, phi = np.zeros(self.size), np.zeros(self.size)
+        if h.at is not None:  # the exact columns are c and phi themselves
+            c[j], phi[j + 1] = 1.0, 1.0
+            return c, phi
+        (g0, g1), (s0, s1) = h.kind.gain, h.kind.shift
+        c[j], c[j + 1] = s0, g0 - 1.0
+        phi[j], phi[j + 1] = s1, g1
+        return c, phi
+
+
+def _schur(S: np.ndarray, basis: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """Gram matrix of the combinations W (size, q) after projecting out the combinations ``basis``."""
+    SB = S @ basis
+    return W.T @ S @ W - (W.T @ SB) @ np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True) @ (SB.T @ W)
+
+
+def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], values: np.ndarray,
+               candidates: list[Hypothesis], transient: np.ndarray) -> WindowFit:
+    """Fit the model's faults on ``rows`` and test each candidate added to them.
+
+    values: (len(model),) the model faults' decided sizes (for ``power``); transient: the
+    whitened free-response columns for ``len(rows)`` (:meth:`RegressorBank.transient`).
+    """
+    Z = _Columns(bank, rows, transient, model + candidates)
+    free = np.eye(Z.size)[:, :Z.n_t]
+    model_cols = [Z.hypothesis(h) for h in model]
+    y = Z.unit(Z.n_t) - sum((c for c, _ in model_cols), np.zeros(Z.size))
+    basis = np.column_stack([free] + [phi[:, None] for _, phi in model_cols])
+    SB = Z.S @ basis
+    theta_model = (np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True) @ (SB.T @ y))[Z.n_t:]
+    J_model = float(_schur(Z.S, basis, y[:, None])[0, 0])
+    removal, power = np.zeros(len(model)), np.zeros(len(model))
+    for i, (c, phi) in enumerate(model_cols):
+        others = np.delete(basis, Z.n_t + i, axis=1)
+        gram = _schur(Z.S, others, np.column_stack([y + c, c + values[i] * phi]))
+        removal[i], power[i] = gram[0, 0] - J_model, gram[1, 1]
+    if not candidates:
+        return WindowFit(J_model, theta_model, removal, power, np.zeros(0), np.zeros(0), np.zeros(0))
+    cols = [Z.hypothesis(h) for h in candidates]
+    U = np.column_stack([y - c for c, _ in cols])  # each candidate's target
+    X = np.column_stack([phi for _, phi in cols])
+    gram = _schur(Z.S, basis, np.hstack([U, X]))
+    H = len(candidates)
+    uu, ux, xx = np.diagonal(gram[:H, :H]), np.diagonal(gram[:H, H:]), np.diagonal(gram[H:, H:])
+    seen = xx > 1e-12 * max(float(np.max(xx)), 1e-300)
+    theta = np.where(seen, ux / np.where(seen, xx, 1.0), np.nan)
+    J = uu - np.where(seen, ux * np.nan_to_num(theta), 0.0)
+    return WindowFit(J_model, theta_model, removal, power, J_model - J, theta, np.where(seen, xx, 0.0))

@@ -1,0 +1,151 @@
+"""Actuator-fault hypotheses as regressions on the bias observer's estimate.
+
+The bias observer (Liu et al. 2014, Theorem 2, any form) estimates ``d = tau - tau_d``: the
+generalised force (N, N m) delivered beyond what healthy actuators would deliver,
+``tau_d = tau(y, u_e)``. Its sampled-data form (:mod:`uvsym.observers.discrete`, trapezoidal
+rule) is a linear filter of d with the observer's constant error matrix P:
+
+    r_k = Phi r_{k-1} + Gamma (d_{k-1} + d_k) / 2,
+    Phi = (I - dt/2 P)^-1 (I + dt/2 P),   Gamma = -(I - dt/2 P)^-1 P dt.
+
+A fault of kind ``deliver(v, f) = (g0 + g1 f) v + s0 + s1 f`` (:class:`uvsym.faults.ActuatorKind`)
+on actuator a, commanded to deliver ``v = u_e,a``, changes the delivered force by
+``B_a(y, u_e) [((g0 - 1) v + s0) + f (g1 v + s1)]`` to first order (``B_a`` the column of
+``d tau / d u``, taken inside the actuator's limits so that a command on its limit does not see the
+kink of the saturation). Every hypothesis (a, kind) is therefore linear in its size f:
+``r = c + f phi`` with c and phi combinations of the two filtered series ``F[B_a]`` and
+``F[B_a v]`` that :class:`RegressorBank` keeps. The filter's state at a window's first sample
+carries the history before it; the n columns ``Phi^j`` span that free response and are projected
+out of every fit, so a window's verdict depends on its own samples only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.signal
+
+from uvsym.errors import ObserverError
+from uvsym.models.model import Model
+
+__all__ = ["RegressorBank"]
+
+_INSIDE = 1e-6  # B is taken this fraction of the actuator's range inside its limits
+
+
+class RegressorBank:
+    """Filtered per-actuator regressors and the residual over a growing record.
+
+    model: the vehicle; P: (n, n) the bias observer's error matrix (constant, real negative
+    eigenvalues); dt: sample period (s); sigma: (n,) noise level of the residual per force
+    channel (N, N m), the whitening of every fit. After :meth:`append`, ``r`` is (N, n),
+    ``G`` and ``H`` are (N, m, n): ``F[B_a]`` and ``F[B_a u_e,a]`` per actuator a.
+    """
+
+    def __init__(self, model: Model, P: np.ndarray, dt: float, sigma: np.ndarray):
+        self.model, self.dt = model, float(dt)
+        self.n, self.m = model.dof, model.n_inputs
+        self.sigma = np.asarray(sigma, dtype=float)
+        eigenvalues, V = np.linalg.eig(np.asarray(P, dtype=float))
+        if np.max(np.abs(eigenvalues.imag)) > 1e-9 * np.max(np.abs(eigenvalues)) or np.any(eigenvalues.real >= 0):
+            raise ObserverError(f"diagnosis: the residual observer's error matrix must have real negative "
+                                f"eigenvalues, got {np.round(eigenvalues, 6).tolist()}")
+        lam = eigenvalues.real
+        self.V, self.V_inv = V.real, np.linalg.inv(V.real)
+        self.phi = (1 + dt * lam / 2) / (1 - dt * lam / 2)  # per mode
+        self.gamma = -lam * dt / (1 - dt * lam / 2)
+        self.Phi = self.V @ np.diag(self.phi) @ self.V_inv
+        self._state = None  # per mode: filter state (lfilter zi) and the last raw regressor
+        self._last = None
+        self.r = np.zeros((0, self.n))
+        self.G = np.zeros((0, self.m, self.n))
+        self.H = np.zeros((0, self.m, self.n))
+        self.u_e = np.zeros((0, self.m))
+        self.y = np.zeros((0, 2 * self.n))
+        lower, upper = np.asarray(model.u_min, dtype=float), np.asarray(model.u_max, dtype=float)
+        margin = _INSIDE * (upper - lower)
+        self._inside = (lower + margin, upper - margin)
+
+    def __len__(self) -> int:
+        return len(self.r)
+
+    def append(self, y: np.ndarray, u_e: np.ndarray, r: np.ndarray) -> None:
+        """Add samples: y (k, 2n) measured [eta; nu], u_e (k, m) expected actuator values, r (k, n) residual."""
+        k = len(r)
+        if k == 0:
+            return
+        u_in = np.clip(u_e, *self._inside)
+        n, m = self.n, self.m
+        B = np.asarray(self.model.B.raw.map(k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
+        B = B.reshape(n, k, m).transpose(1, 2, 0)  # (k, m, n): column a of B per sample
+        raw = np.concatenate([B, B * u_e[:, :, None]], axis=1)  # (k, 2m, n)
+        previous = raw[:1] if self._last is None else self._last[None]
+        averaged = (np.concatenate([previous, raw[:-1]]) + raw) / 2
+        modal = averaged @ self.V_inv.T  # (k, 2m, n) in modal coordinates
+        if self._state is None:
+            self._state = np.zeros((n, 1, 2 * m))
+        filtered = np.empty_like(modal)
+        for j in range(n):
+            filtered[:, :, j], self._state[j] = scipy.signal.lfilter(
+                [self.gamma[j]], [1.0, -self.phi[j]], modal[:, :, j], axis=0, zi=self._state[j])
+        filtered = filtered @ self.V.T
+        self._last = raw[-1]
+        self.G = np.concatenate([self.G, filtered[:, :m]])
+        self.H = np.concatenate([self.H, filtered[:, m:]])
+        self.r = np.concatenate([self.r, np.asarray(r, dtype=float)])
+        self.u_e = np.concatenate([self.u_e, np.asarray(u_e, dtype=float)])
+        self.y = np.concatenate([self.y, np.asarray(y, dtype=float)])
+
+    def exact(self, rows: np.ndarray, actuator: int, kind, theta: float, onset: int) -> tuple[np.ndarray, np.ndarray]:
+        """(c, phi), each (len(rows), n): the fault's exact effect on the residual linearised at ``theta``.
+
+        ``D(f) = tau(y, u_e with actuator a delivering deliver(u_e,a, f)) - tau(y, u_e)`` on each sample
+        from ``onset`` on (zero before), through the vehicle's own force model (saturation, quadratic
+        thrust and fin drag included); ``D(f) ~ D(theta) + (f - theta) D'(theta)`` gives
+        ``c = F[D(theta) - theta D']`` and ``phi = F[D']``, filtered from a zero state at the window's first
+        sample (the free response is projected out of every fit).
+        """
+        n, length = self.n, len(rows)
+        y, u_e = self.y[rows], self.u_e[rows]
+        step = 1e-6 * max(1.0, abs(theta))
+        u = np.repeat(u_e[None], 3, axis=0)  # healthy, theta - step, theta + step
+        u[1, :, actuator] = kind.deliver(u_e[:, actuator], theta - step)
+        u[2, :, actuator] = kind.deliver(u_e[:, actuator], theta + step)
+        eta, nu = np.tile(y[:, :n].T, 3), np.tile(y[:, n:].T, 3)
+        tau = np.asarray(self.model.tau.raw.map(3 * length)(eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
+        tau = tau.T.reshape(3, length, n)
+        low, high = tau[1] - tau[0], tau[2] - tau[0]
+        active = (rows >= onset)[:, None]
+        D = active * (low + high) / 2
+        slope = active * (high - low) / (2 * step)
+        return self._filter(D - theta * slope), self._filter(slope)
+
+    def _filter(self, series: np.ndarray) -> np.ndarray:
+        """``series`` (L, n) through the observer's filter from a zero state (trapezoidal inputs)."""
+        averaged = (np.concatenate([series[:1], series[:-1]]) + series) / 2
+        modal = averaged @ self.V_inv.T
+        out = np.empty_like(modal)
+        for j in range(self.n):
+            out[:, j] = scipy.signal.lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[:, j])
+        return out @ self.V.T
+
+    def transient(self, length: int) -> np.ndarray:
+        """(length n, n) whitened free response ``Phi^j e_i`` of the filter over a window."""
+        powers = np.empty((length, self.n, self.n))
+        powers[0] = np.eye(self.n)
+        for j in range(1, length):
+            powers[j] = self.Phi @ powers[j - 1]
+        return (powers / self.sigma[None, :, None]).reshape(length * self.n, self.n)
+
+    def gated(self, series: np.ndarray, rows: np.ndarray, onset: int) -> np.ndarray:
+        """``series`` (N, n) on the contiguous ``rows`` as if its input started at sample ``onset``: zero
+        before it, the free response ``Phi^(k - onset + 1)`` of the state at ``onset - 1`` removed after it."""
+        out = series[rows].copy()
+        if onset <= rows[0]:
+            return out  # the difference is a free response from the window's start: projected out anyway
+        after = rows >= onset
+        out[~after] = 0.0
+        if onset >= 1 and np.any(after):
+            steps = np.arange(1, int(np.count_nonzero(after)) + 1)
+            modal = self.V_inv @ series[onset - 1]
+            out[after] -= (self.phi[None, :] ** steps[:, None] * modal[None, :]) @ self.V.T
+        return out

@@ -1,0 +1,84 @@
+"""Settings of the continuous actuator diagnosis, with units, defaults and the thresholds they imply."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from scipy.stats import chi2
+
+from uvsym.errors import DiagnosisError
+from uvsym.faults import ACTUATOR_KINDS
+
+__all__ = ["DiagnosisSettings"]
+
+
+@dataclass(frozen=True)
+class DiagnosisSettings:
+    """How the diagnosis decides (every field is validated; an error names it as ``diagnosis.<field>``).
+
+    observer: the bias observer (by name) whose estimate is the residual; kinds: fault kinds
+    hypothesised per actuator; actuators: candidate actuator labels (empty: all); window_s (s):
+    the sliding window of every test; min_window_s (s): the shortest post-alarm record an
+    isolation is decided on; period_s (s): time between decisions; confirm: consecutive decisions
+    that must agree before a state changes; false_alarm_rate: probability that one test of a
+    healthy window alarms (Bonferroni-split over the hypotheses); isolation_error_rate: the
+    chance that noise alone puts a wrong hypothesis this far ahead of the right one (sets the
+    isolation margin); resolution: the smallest fault of a kind that scales the command (-) that
+    must be detectable, else the actuator is "unexcited"; noise: measured channel -> standard
+    deviation of its sensor noise (the channel's unit); floor: model-error floor of each force
+    channel's noise level, as a fraction of the force the actuators can produce on it; correct:
+    feed the identified faults back as a command correction.
+    """
+
+    observer: str = "bias"
+    kinds: tuple[str, ...] = ("proportional", "bias", "constant")
+    actuators: tuple[str, ...] = ()
+    window_s: float = 2.0
+    min_window_s: float = 0.5
+    period_s: float = 0.1
+    confirm: int = 3
+    false_alarm_rate: float = 1e-6
+    isolation_error_rate: float = 1e-3
+    resolution: float = 0.05
+    noise: dict[str, float] = field(default_factory=dict)
+    floor: float = 1e-3
+    correct: bool = False
+
+    def __post_init__(self):
+        for name in ("window_s", "min_window_s", "period_s", "resolution", "floor"):
+            _positive(name, getattr(self, name))
+        for name in ("false_alarm_rate", "isolation_error_rate"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and 0 < value < 1):
+                raise DiagnosisError(f"diagnosis.{name}: expected a probability in (0, 1), got {value!r}")
+        if self.min_window_s > self.window_s:
+            raise DiagnosisError(f"diagnosis.min_window_s: {self.min_window_s} s is longer than "
+                                 f"diagnosis.window_s = {self.window_s} s")
+        if isinstance(self.confirm, bool) or not isinstance(self.confirm, int) or self.confirm < 1:
+            raise DiagnosisError(f"diagnosis.confirm: expected a positive integer (decisions), got {self.confirm!r}")
+        if not self.kinds:
+            raise DiagnosisError("diagnosis.kinds: at least one fault kind is needed")
+        for kind in self.kinds:
+            if kind not in ACTUATOR_KINDS:
+                raise DiagnosisError(f"diagnosis.kinds: unknown fault kind {kind!r}; known: "
+                                     f"{', '.join(ACTUATOR_KINDS)}")
+        for channel, std in self.noise.items():
+            if not (isinstance(std, (int, float)) and math.isfinite(std) and std >= 0):
+                raise DiagnosisError(f"diagnosis.noise.{channel}: expected a standard deviation >= 0, got {std!r}")
+        if not isinstance(self.correct, bool):
+            raise DiagnosisError(f"diagnosis.correct: expected true or false, got {self.correct!r}")
+
+    def detection_threshold(self, hypotheses: int) -> float:
+        """GLR above which a window alarms: chi2(1) quantile at false_alarm_rate / hypotheses."""
+        return float(chi2.isf(self.false_alarm_rate / max(hypotheses, 1), 1))
+
+    @property
+    def isolation_margin(self) -> float:
+        """GLR lead (noise variances) the best hypothesis needs over every rival."""
+        return float(chi2.isf(self.isolation_error_rate, 1))
+
+
+def _positive(name: str, value) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (value > 0 and math.isfinite(value)):
+        raise DiagnosisError(f"diagnosis.{name}: expected a positive finite number, got {value!r}")
