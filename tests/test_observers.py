@@ -168,13 +168,16 @@ def _synthetic(kind_true: str, kind_observer: str, T: float = 6.0, dt: float = 0
         f_true = f_a if kind_observer == "bias" else (tau_d + f_a) / tau_d
     else:
         f_true = f_p if kind_observer == "proportional" else (f_p - 1) * tau_d
-    # integrate e' = A(t) e exactly for the matched case; the mismatched "fault" drifts with tau_d
+    # integrate e' = A(t) e exactly for the matched case; the mismatched "fault" drifts with tau_d. The rates
+    # are the paper's closed form for a diagonal M (Theorems 1-2), not the observer's own error_matrix, which
+    # isolation inverts: A = -K (M^-1 T_d)^2 for the proportional observer, -K M^-2 for the bias one
+    m = np.diag(model.M)
     f_hat = np.zeros_like(tau_d)
     e = f_true[0] if np.ndim(f_true) == 2 else f_true.copy()
     for k in range(len(t)):
         target = f_true[k] if np.ndim(f_true) == 2 else f_true
         if k:
-            A = np.diag(np.asarray(observer.error_matrix(tau_d[k], K)))
+            A = -K * ((tau_d[k] / m) ** 2 if kind_observer == "proportional" else 1.0 / m**2)
             e = (target - f_hat[k - 1]) * np.exp(A * dt)
         f_hat[k] = target - e
     return observer, K, t, f_hat, tau_d
