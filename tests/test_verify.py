@@ -57,6 +57,31 @@ def test_counterexamples_really_violate_their_claims(claims):
             assert np.max(np.abs(derived - claimed)) > 1e-6 * max(1.0, np.max(np.abs(derived)))
 
 
+def test_convergence_claims_agree_with_the_closed_form_rates(claims):
+    """Not judged by the labels the derivation sets: in the momentum form A = -K T_d^2 (proportional) or -K (bias)
+    is diagonal, so V decreases at rate 2 gamma over the box exactly when every k_i tau_min^2 (or k_i) exceeds
+    gamma; a proved claim's P must satisfy P > 0 and A^T P + P A + 2 gamma P < 0 at every corner (numpy)."""
+    import itertools
+
+    from derivations.actuator_observers.claims import GAINS
+
+    cases = [("docking_auv", "proportional", GAINS, 0.5, 20.0, 0.5), ("remus100", "proportional", GAINS, 0.5, 20.0,
+                                                                     0.5),
+             ("remus100", "bias", GAINS, 1.0, 1.0, 1.0), ("remus100", "bias", np.r_[GAINS[:5], -1.0], 1.0, 1.0, 0.0)]
+    convergence = [c for c in claims if "decreases at rate" in c.claim]
+    assert len(convergence) == len(cases)
+    for certificate, (vehicle_name, kind, K, tau_min, tau_max, gamma) in zip(convergence, cases):
+        assert vehicle_name in certificate.claim and f"rate {2 * gamma:g}" in certificate.claim
+        rates = K * tau_min**2 if kind == "proportional" else K
+        assert certificate.status == ("proved" if np.all(rates > gamma) else "refuted"), certificate.claim
+        if certificate.status == "proved" and "P" in certificate.details:
+            P = np.array(certificate.details["P"])
+            assert np.linalg.eigvalsh(P).min() > 0
+            for tau in itertools.product(*[(tau_min, tau_max)] * len(K)):
+                A = -np.diag(K * np.array(tau) ** 2 if kind == "proportional" else K)
+                assert np.linalg.eigvalsh(A.T @ P + P @ A + 2 * gamma * P).max() < 0
+
+
 def _loop_V_dot(claim: str, nu) -> float:
     """V' = 2 nu' M nu_dot of the section 3.2 loop, rebuilt here from the model and the faults' definitions."""
     from uvsym import vehicle
