@@ -6,17 +6,23 @@ other observer's; the first sample where this holds is the decision time; an obs
 value names no fault (healthy). The variances and means below are set by hand (powers of two, so that the margin
 boundary is exact), and the expected decision row follows from the rule, not from the code. The supervisor's
 timing is read on a stub isolation result: the correction comes back from the very update that identifies a
-fault, and a channel decided healthy clears the actuators that act only on healthy channels.
+fault, and a channel decided healthy clears the actuators that act only on healthy channels; a simulated loop
+applies a correction from the first sample after the chunk its supervisor checked.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from uvsym.models.registry import vehicle
+from uvsym.observers.ftc import Correction
 from uvsym.observers.isolation import ChannelDecision, IsolationResult, IsolationSettings, Isolator
 from uvsym.observers.supervisor import FaultDiagnosis
+from uvsym.sim.scenario import load_scenario
+from uvsym.sim.simulation import simulate_scenario
 
 T = np.arange(6) * 0.1  # s
 V = 2.0**-17  # a variance well below the default threshold (1e-4)
@@ -158,3 +164,29 @@ def test_without_correction_the_supervisor_only_identifies():
     diagnosis.isolator = StubIsolator([{"X": ("bias", -4.0)} | {c: ("healthy", 0.0) for c in "YZKMN"}])
     assert diagnosis.update(T[:3], _signals(3)) is None
     assert diagnosis.identified["X"].value == pytest.approx(-4.0, abs=1e-9)
+
+
+class CorrectOnce:
+    """A supervisor that returns one correction (add 5 N to the thruster command) at its first check."""
+
+    period = 0.3  # s: 30 samples of 0.01 s
+
+    def __init__(self):
+        self.checked = []
+
+    def update(self, t, signals):
+        self.checked.append((t[0], t[-1]))
+        return Correction(np.eye(4), np.array([5.0, 0.0, 0.0, 0.0])) if len(self.checked) == 1 else None
+
+
+def test_a_correction_acts_from_the_first_sample_after_the_checked_chunk():
+    """The first check sees t = 0 ... 0.29 s; its correction changes the command from t = 0.3 s on, not later."""
+    scenario = replace(load_scenario("docking_faults"), duration=1.0)
+    supervisor = CorrectOnce()
+    result = simulate_scenario(scenario, supervisor=supervisor)
+    assert supervisor.checked[:2] == [(0.0, pytest.approx(0.29)), (pytest.approx(0.3), pytest.approx(0.59))]
+    added = result["u_command"].values - result["u_desired"].values
+    on = result.t >= 0.3 - 1e-9
+    assert np.count_nonzero(~on) == 30
+    np.testing.assert_array_equal(added[~on], 0.0)
+    np.testing.assert_allclose(added[on], np.tile([5.0, 0.0, 0.0, 0.0], (np.count_nonzero(on), 1)), atol=1e-12)
