@@ -38,6 +38,8 @@ def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: in
     store = ResultStore(default_out(campaign) if out_dir is None else out_dir, campaign.name, force)
     load_hook(campaign.settings)
     options = dict(campaign.executor)
+    if executor == "local" and scheduler is None:  # asked for by name: the file's scheduler does not apply
+        options["scheduler"] = None
     options.update({k: v for k, v in (("workers", workers), ("scheduler", scheduler), ("chunk_size", chunk_size))
                     if v is not None})
     if isinstance(executor, str) or executor is None:

@@ -206,7 +206,10 @@ def _case(fields: Fields, root: Path) -> dict:
         name = fields.text("name")
         where = f"case {name!r}"
         base, scenario_name = _scenario_table(fields, root)
-        for path, value in (fields.raw("set", {}) or {}).items():
+        assignments = fields.raw("set", {})
+        if not isinstance(assignments, dict):
+            raise CampaignError(f"{where}: set: expected a table of path = value, got {assignments!r}")
+        for path, value in assignments.items():
             _apply(base, path, value, f"{where}: set")
         grid = fields.raw("grid", None)
         monte_carlo = fields.raw("monte_carlo", None)
