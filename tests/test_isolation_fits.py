@@ -1,0 +1,112 @@
+"""Predicted faults (Liu et al. 2014, eqs. 19-24) from estimates with a closed form, for an observer whose error
+matrix is chosen by hand: A = -diag(K), so channel i converges at rate K_i (1/s).
+
+- exponential fit (eq. 19): f_hat(t) = f - C exp(-a t) is fitted exactly, f_bar = f;
+- line and quadratic fits (eqs. 22-24): f_bar = f_hat(t_end) - A^-1 f_hat'(t_end) = f_hat(t_end) + f_hat'(t_end) / a,
+  exact for an f_hat that is a polynomial of the fit's order.
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from uvsym.errors import ObserverError
+from uvsym.observers.isolation import IsolationSettings, predicted_faults
+
+DT = 0.01  # s
+T = np.arange(0.0, 2.0, DT)  # s
+W = 100  # samples per window of the default 1 s
+
+
+def _rates() -> SimpleNamespace:
+    """An observer whose error matrix is -diag(K) whatever tau_d: A_ii = -K_i."""
+    K = ca.SX.sym("K", 2)
+    return SimpleNamespace(error_matrix=ca.Function("A", [ca.SX.sym("tau_d", 2), K], [-ca.diag(K)]))
+
+
+RATES = _rates()
+
+
+def predict(f_hat, K=(5.0, 4.0), **settings):
+    tau_d = np.ones((len(T), 2))
+    return predicted_faults(RATES, np.array(K), T, f_hat, tau_d, IsolationSettings(**settings))
+
+
+def test_the_exponential_fit_recovers_the_fault_before_the_estimate_converges():
+    f, C, a = np.array([13.0, -2.0]), np.array([13.0, 5.0]), np.array([5.0, 4.0])
+    f_hat = f - C * np.exp(-np.outer(T, a))
+    f_bar, visible = predict(f_hat)
+    assert visible.all()
+    assert np.isnan(f_bar[:W - 1]).all()  # no full window yet
+    np.testing.assert_allclose(f_bar[W - 1:], np.tile(f, (len(T) - W + 1, 1)), rtol=0, atol=1e-9)
+    assert abs(f_hat[W - 1, 0] - 13.0) > 0.08  # the estimate itself is still off by C exp(-5 t)
+
+
+@pytest.mark.parametrize("fit, order", [("line", 1), ("quadratic", 2)])
+def test_polynomial_fits_apply_eq_21_at_the_window_end(fit, order):
+    a = np.array([5.0, 4.0])
+    coefficients = np.array([[1.0, -3.0], [0.5, 2.0], [0.25, -0.75]])[:order + 1]  # f_hat = sum c_j t^j
+    f_hat = sum(np.outer(T**j, c) for j, c in enumerate(coefficients))
+    slope = sum(j * np.outer(T ** (j - 1), c) for j, c in enumerate(coefficients) if j)
+    f_bar, _ = predict(f_hat, fit=fit)
+    np.testing.assert_allclose(f_bar[W - 1:], (f_hat + slope / a)[W - 1:], rtol=1e-9, atol=1e-9)
+
+
+def test_a_line_fit_misses_a_curved_estimate_that_the_quadratic_fit_follows():
+    f_hat = np.column_stack([T**2, T**2])
+    exact = f_hat + 2 * T[:, None] / np.array([5.0, 4.0])
+    line, _ = predict(f_hat, fit="line")
+    quadratic, _ = predict(f_hat, fit="quadratic")
+    np.testing.assert_allclose(quadratic[W - 1:], exact[W - 1:], rtol=1e-9, atol=1e-9)
+    assert np.abs(line[W - 1:] - exact[W - 1:]).min() > 1e-3
+
+
+@pytest.mark.parametrize("fit", ["exponential", "line", "quadratic"])
+def test_a_channel_converging_slower_than_one_per_window_is_hidden(fit):
+    """K_2 = 0.5 / s < 1 / window_s: channel 2 is not observable, its f_bar NaN; channel 1 unaffected."""
+    f_hat = np.column_stack([3.0 - np.exp(-5.0 * T), 1.0 + 0 * T])
+    f_bar, visible = predict(f_hat, K=(5.0, 0.5), fit=fit)
+    assert visible[:, 0].all() and not visible[:, 1].any()
+    assert np.isnan(f_bar[:, 1]).all()
+    assert np.isfinite(f_bar[W - 1:, 0]).all()
+    f_bar, visible = predict(f_hat, K=(5.0, 1.0), fit=fit)  # exactly one per window: observable
+    assert visible[:, 1].all() and np.isfinite(f_bar[W - 1:, 1]).all()
+
+
+def test_a_window_longer_than_the_record_gives_no_prediction():
+    f_bar, visible = predicted_faults(RATES, np.array([5.0, 4.0]), T[:50], np.ones((50, 2)), np.ones((50, 2)),
+                                      IsolationSettings())
+    assert f_bar.shape == (50, 2) and np.isnan(f_bar).all() and visible.all()
+
+
+def test_shorter_windows_predict_earlier():
+    f_hat = 2.0 - np.exp(-np.outer(T, [5.0, 4.0]))
+    f_bar, _ = predict(f_hat, window_s=0.25)
+    assert np.isnan(f_bar[:24]).all() and np.isfinite(f_bar[24:]).all()  # 0.25 s = 25 samples
+
+
+def test_uneven_sampling_and_mismatched_shapes_are_refused():
+    uneven = T.copy()
+    uneven[10] += DT / 3
+    with pytest.raises(ObserverError, match="uniformly sampled"):
+        predicted_faults(RATES, np.array([5.0, 4.0]), uneven, np.ones((len(T), 2)), np.ones((len(T), 2)))
+    with pytest.raises(ObserverError, match="matching rows"):
+        predicted_faults(RATES, np.array([5.0, 4.0]), T, np.ones((len(T), 2)), np.ones((len(T) - 1, 2)))
+
+
+@pytest.mark.parametrize("name", ["window_s", "threshold", "margin", "healthy_tolerance", "healthy_tolerance_p"])
+@pytest.mark.parametrize("value", [0.0, -1.0, math.inf, math.nan])
+def test_isolation_settings_must_be_positive_and_finite(name, value):
+    with pytest.raises(ObserverError, match=f"isolation setting {name} must be positive and finite"):
+        IsolationSettings(**{name: value})
+
+
+def test_an_unknown_fit_is_refused_with_the_known_ones():
+    with pytest.raises(ObserverError, match="unknown isolation fit 'cubic'; known: exponential, line, quadratic"):
+        IsolationSettings(fit="cubic")
+    assert IsolationSettings() == IsolationSettings(1.0, "exponential", 1e-4, 0.1, 0.05, 0.01)  # the paper's
