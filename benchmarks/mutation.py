@@ -23,12 +23,14 @@ from __future__ import annotations
 import argparse
 import fnmatch
 import importlib.metadata
+import io
 import json
 import os
 import re
 import shutil
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 import tomllib
@@ -63,15 +65,22 @@ def _toml_value(value) -> str:
     return json.dumps(value)
 
 
-def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str]) -> None:
-    """The working tree's files (tracked and untracked, ignored ones and ``without`` left out) in ``scratch``, with
-    ``only_mutate`` narrowed to ``modules`` and test files that do not exist dropped from the selection."""
-    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", "uvsym", "derivations",
-                             "tests"], capture_output=True, text=True, check=True).stdout.split()
+def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str], tests_at: str | None) -> None:
+    """The working tree's files (tracked and untracked, ignored ones and ``without`` left out) in ``scratch``, the
+    tests as commit ``tests_at`` has them if given, with ``only_mutate`` narrowed to ``modules`` and test files
+    that do not exist dropped from the selection."""
+    folders = ["uvsym", "derivations"] + ([] if tests_at else ["tests"])
+    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", *folders],
+                            capture_output=True, text=True, check=True).stdout.split()
     for name in listed + ["pyproject.toml"]:
         if (ROOT / name).is_file() and name not in without:
             (scratch / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(ROOT / name, scratch / name)
+    if tests_at:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", tests_at, "tests"], capture_output=True,
+                                 check=True).stdout
+        with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
+            tar.extractall(scratch, filter="data")
     narrowed = {**config, "only_mutate": modules,
                 "pytest_add_cli_args_test_selection": [t for t in config["pytest_add_cli_args_test_selection"]
                                                        if (scratch / t).exists()]}
@@ -133,6 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--keep", type=Path, help="run in this folder and keep it (default: a temporary one)")
     parser.add_argument("--without", nargs="+", default=[],
                         help="test files to leave out (to measure what the other tests kill)")
+    parser.add_argument("--tests-at", metavar="COMMIT",
+                        help="take tests/ from this commit (to measure what the tests of an earlier commit kill)")
     parser.add_argument("--merge", action="store_true",
                         help="keep the modules and survivors of the last results that this run does not measure")
     parser.add_argument("--before", action="store_true",
@@ -148,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
     scratch = args.keep or Path(tempfile.mkdtemp(prefix="uvsym-mutation-"))
     try:
         scratch.mkdir(parents=True, exist_ok=True)
-        _copy_tree(scratch, config, modules, args.without)
+        _copy_tree(scratch, config, modules, args.without, args.tests_at)
         mutmut = str(Path(sys.executable).parent / "mutmut")
         env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
         run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children)],
@@ -160,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
         outcomes = _outcomes(scratch, modules)
         for module, statuses in outcomes.items():
             per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
+            per_module[module].update(run_seconds=seconds, tests_at=args.tests_at, tests_left_out=args.without)
             survivors += left
             justified |= excused
     finally:
@@ -177,7 +189,8 @@ def main(argv: list[str] | None = None) -> int:
     rates = [m["kill_rate"] for m in per_module.values() if m["kill_rate"] is not None]
     results = {"started": started, "seconds": seconds, "mutmut": importlib.metadata.version("mutmut"),
                "max_children": args.max_children, "modules_requested": args.modules or ["(all configured)"],
-               "tests_left_out": args.without, "mutmut_exit_code": run.returncode, "mutants_measured": len(measured),
+               "tests_left_out": args.without, "tests_at": args.tests_at, "mutmut_exit_code": run.returncode,
+               "mutants_measured": len(measured),
                "modules": per_module, "lowest_kill_rate": min(rates) if rates else None, "survivors": survivors,
                "stale_equivalents": stale}
     for module, m in per_module.items():
