@@ -71,7 +71,7 @@ def metrics(scenario, result, events):
 
 
 def slow(scenario, result, events):
-    time.sleep(1.0)
+    time.sleep(0.5)
     return metrics(scenario, result, events)
 
 

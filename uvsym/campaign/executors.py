@@ -14,6 +14,7 @@ resubmitted run by run, and a run that fails alone gets an error row.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 from collections import deque
@@ -28,6 +29,23 @@ __all__ = ["LocalExecutor", "DaskExecutor", "make_executor", "default_workers"]
 def default_workers() -> int:
     """Local worker processes when none are asked for: the cores this process may use."""
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+# one thread per worker process for the numeric libraries, as Dask's nanny does: idle BLAS threads spin and
+# take cores from the other workers' runs
+_SINGLE_THREADED = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _worker_environment():
+    """os.environ with _SINGLE_THREADED where the user set none, for processes (and the forkserver) started inside."""
+    added = {key: value for key, value in _SINGLE_THREADED.items() if key not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
 
 
 def _context():
@@ -52,7 +70,8 @@ class LocalExecutor:
     def _spawn(self, settings):
         parent, child = self._context.Pipe()
         process = self._context.Process(target=worker.serve, args=(child, settings), daemon=True)
-        process.start()
+        with _worker_environment():
+            process.start()
         child.close()
         self._processes.append((process, parent))
         return process, parent
