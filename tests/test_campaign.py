@@ -310,7 +310,7 @@ def test_a_tiny_campaign_on_local_processes(local_run):
 def test_the_same_campaign_on_a_dask_local_cluster(local_run, tmp_path):
     distributed = pytest.importorskip("distributed", reason="dask.distributed is not installed "
                                                             "(pip install 'uvsym[cluster]')")
-    _, campaign, local = local_run
+    local = local_run[2]
     campaign = load_campaign(_tiny(tmp_path))
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
                                   dashboard_address=None) as cluster:

@@ -196,6 +196,8 @@ def _cmd_simulate(args) -> int:
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
     scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
+    if args.events:
+        _check_events_path(args.events, scenario, args.force)
     figure = None
     if args.plot is not None:  # the figure checked like the result, before the run
         default = Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name if scenario else path.stem}.svg"
@@ -216,10 +218,29 @@ def _cmd_simulate(args) -> int:
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
+    if args.events:
+        from uvsym.diagnosis.events import write_events_records
+
+        print(f"wrote {write_events_records(result.events, args.events)} ({len(result.events)} events)")
     if figure is not None:
         result.plot(figure, overwrite=args.force)
         print(f"wrote {figure}")
     return 0
+
+
+def _check_events_path(path, scenario, force: bool) -> None:
+    """UvsymError before the run: --events needs a scenario with a [diagnosis] table, a .json file whose
+    folder exists, and --force to replace a file."""
+    target = Path(path)
+    if scenario is None or scenario.diagnosis is None:
+        raise UvsymError("--events: the scenario has no [diagnosis] table, so there is no decision log to write "
+                         "(uvsym simulate --schema lists the table's fields)")
+    if target.suffix != ".json":
+        raise UvsymError(f"--events: {path} must end in .json")
+    if not target.parent.is_dir():
+        raise UvsymError(f"--events: folder {target.parent} does not exist")
+    if target.exists() and not force:
+        raise UvsymError(f"--events: {path} exists; pass --force to overwrite it")
 
 
 def _cmd_codegen(args) -> int:
@@ -343,8 +364,12 @@ def _cmd_campaign(args) -> int:
         print(line, file=sys.stderr, flush=True)
 
     out = Path(args.out) if args.out else default_out(campaign)
-    run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
-                 chunk_size=args.chunk_size, progress=progress, force=args.force, log=log)
+    try:
+        run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                     chunk_size=args.chunk_size, progress=progress, force=args.force, log=log)
+    except KeyboardInterrupt:
+        log(f"interrupted: the finished chunks are kept in {out / 'chunks'}; run the same command to resume")
+        return 130
     print(f"wrote {out}: results.parquet, results.csv, summary.json, report.md, report.html")
     return 0
 
@@ -384,7 +409,8 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
     simulate.add_argument("--schema", action="store_true", help="print every field of a vehicle scenario file "
                                                                 "(type, default, rule) as a Markdown table")
-    simulate.add_argument("--force", action="store_true", help="overwrite an existing --out or --plot file")
+    simulate.add_argument("--events", help="write the diagnosis's decision log (.json; needs a [diagnosis] table)")
+    simulate.add_argument("--force", action="store_true", help="overwrite an existing --out, --plot or --events file")
     simulate.set_defaults(run=_cmd_simulate)
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "
                                              "a set's own options as --name value (uvsym codegen --list)")
