@@ -48,6 +48,7 @@ TARGETS = {"batched_traj_sim_s_per_wall_s_per_core_min": 150_000, "scalar_sim_s_
 DURATION = 100.0
 BATCH_S = 1e-3  # wall seconds per timed batch
 BATCHES = 200
+OTHER_LANES = (8, 16)  # lane counts measured besides the default, for the choice of LANES
 
 
 def docking_runs(count: int):
@@ -90,9 +91,9 @@ def rates(roll, z, W, out, trajectories: int, dt: float) -> dict:
 
 
 def measure(lanes: int) -> dict:
-    """One repeat: the scalar and batched rates, the warm start, end-to-end batch and scalar wall times."""
+    """One repeat: the scalar and batched rates (also with other lane counts), the warm start, end-to-end batch."""
     load = list(os.getloadavg())
-    scenarios = docking_runs(lanes)
+    scenarios = docking_runs(max(lanes, *OTHER_LANES))
     first = scenarios[0]
     dt = first.step
     observers = observer_blocks(first.model, first.observers, dt)
@@ -104,10 +105,14 @@ def measure(lanes: int) -> dict:
 
     loop = build_closed_loop(first.model, first.controller, dt, observers=observers)
     batch = [prepare_run(s.model, s.controller, **scenario_arguments(s, observers), loop=loop) for s in scenarios]
-    W = np.ascontiguousarray(np.stack([run.W for run in batch], axis=-1))
-    z0 = np.ascontiguousarray(np.stack([run.z0 for run in batch], axis=-1))
-    out_lanes = np.empty((W.shape[0], loop.step.nnz_out(1), lanes))
-    batched = rates(compile_lanes(loop.step, lanes), z0, W, out_lanes, lanes, dt)
+    by_lanes = {}
+    for count in (lanes, *OTHER_LANES):
+        W = np.ascontiguousarray(np.stack([run.W for run in batch[:count]], axis=-1))
+        z0 = np.ascontiguousarray(np.stack([run.z0 for run in batch[:count]], axis=-1))
+        out_lanes = np.empty((W.shape[0], loop.step.nnz_out(1), count))
+        by_lanes[count] = rates(compile_lanes(loop.step, count), z0, W, out_lanes, count, dt)
+    batched = by_lanes[lanes]
+    scenarios = scenarios[:lanes]
 
     simulate_scenario(first)  # the first run compiles (or finds the library in the cache)
     warm = []
@@ -121,7 +126,8 @@ def measure(lanes: int) -> dict:
     simulate_batch(scenarios, lanes=lanes)
     batch_wall = time.perf_counter() - begun
     return {"load_average_before": load, "scalar_fast_flags": scalar_fast, "scalar_default_flags": scalar_default,
-            "batched": batched, "warm_start_s": {"min": min(warm), "median": float(np.median(warm))},
+            "batched": batched, "batched_median_by_lanes": {str(k): v["median"] for k, v in by_lanes.items()},
+            "warm_start_s": {"min": min(warm), "median": float(np.median(warm))},
             "simulate_batch_end_to_end_s": batch_wall,
             "simulate_batch_end_to_end_traj_sim_s_per_wall_s": lanes * DURATION / batch_wall,
             "ratios": {"batched_vs_scalar": batched["median"] / scalar_fast["median"],

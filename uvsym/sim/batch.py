@@ -30,7 +30,7 @@ from uvsym.sim.simulation import PreparedRun, observer_blocks, prepare_run, scen
 
 __all__ = ["LANES", "simulate_batch", "run_lanes"]
 
-LANES = 8  # trajectories per compiled step (benchmarks/campaign.py measures the choice)
+LANES = 4  # trajectories per compiled step: one AVX2 vector; 8 and 16 measured slower (benchmarks/campaign.py)
 
 
 def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substeps: int = 1, compiled: bool = True,
