@@ -8,6 +8,7 @@ only picklable arguments.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
 import time
 
@@ -90,7 +91,9 @@ def run_chunk(runs: list[Run], settings: Settings) -> list[dict]:
 
 
 def serve(conn, settings: Settings) -> None:
-    """A local worker process: receive runs on ``conn``, send back their rows, until None or the driver goes."""
+    """A local worker process: receive runs on ``conn``, send back their rows, until None or the driver
+    goes. Ctrl-C is the driver's to handle (it stops the workers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     hook = load_hook(settings)
     while True:
         try:
