@@ -4,12 +4,16 @@ so that a P the solver calls optimal but that fails the exact check cannot becom
 
 from __future__ import annotations
 
+import re
+from dataclasses import replace
 from fractions import Fraction
 
 import cvxpy as cp
 import numpy as np
 import pytest
 
+from uvsym.errors import VerificationError
+from uvsym.verify.certificate import Certificate
 from uvsym.verify.lyapunov import discrete_lyapunov_decrease, exact_positive_definite, lyapunov_decrease
 
 
@@ -142,3 +146,106 @@ def test_a_discrete_map_at_the_rate_is_refuted_with_its_eigenvalue():
     assert refuted.status == "refuted" and refuted.counterexample["eigenvalue_modulus"] == pytest.approx(0.5)
     assert refuted.margin == pytest.approx(0.0, abs=1e-12)
     assert discrete_lyapunov_decrease("contracts", jordan, 0.6, "one matrix").status == "proved"
+
+
+def _timed(certificate):
+    """The certificate with its run time zeroed, after checking that one was measured."""
+    assert isinstance(certificate.seconds, float) and certificate.seconds > 0
+    return replace(certificate, seconds=0.0)
+
+
+def test_a_discrete_refutation_names_the_eigenvalue_by_modulus():
+    """diag(-0.9, 0.2): modulus 0.9 >= rho = 0.5 (its real part, -0.9, would not show it)."""
+    certificate = discrete_lyapunov_decrease("contracts", np.diag([-0.9, 0.2]), 0.5, "one map", expected="refuted")
+    assert _timed(certificate) == Certificate(
+        "contracts", "one map", "Schur test of the sampled map (Moebius map and Routh-Hurwitz in exact rationals): "
+        "an eigenvalue of modulus >= rho", "refuted", "refuted", margin=pytest.approx(-0.4),
+        counterexample={"A": [[-0.9, 0.0], [0.0, 0.2]], "eigenvalue_modulus": pytest.approx(0.9), "rho": 0.5,
+                        "eigenvector_real": [1.0, 0.0], "exact_test": "Schur"})
+
+
+def test_a_discrete_proof_carries_the_stein_P_or_falls_back_to_the_schur_test(monkeypatch):
+    a, rho = 0.5, 0.8
+    p = 1.0 / (1.0 - (a / ((a + rho) / 2)) ** 2)  # scipy's P = p I (see the closed-form margin above)
+    certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map")
+    np.testing.assert_allclose(certificate.details.pop("P"), p * np.eye(2), rtol=1e-12, atol=1e-12)
+    assert _timed(certificate) == Certificate(
+        "contracts", "one map", "discrete Lyapunov (Stein) inequality, P from scipy, re-checked by exact rational "
+        "LDL^T", "proved", "proved", margin=pytest.approx(p * (rho**2 - a**2)),
+        details={"spectral_radius": pytest.approx(a)})
+    import uvsym.verify.lyapunov as lyapunov
+
+    for failure in (np.linalg.LinAlgError("singular"), ValueError("bad"), None):
+        def broken(A, Q, failure=failure):
+            if failure is None:
+                return np.full((2, 2), np.nan)
+            raise failure
+        monkeypatch.setattr(lyapunov, "solve_discrete_lyapunov", broken)
+        certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map")
+        assert _timed(certificate) == Certificate(
+            "contracts", "one map", "Schur test in exact rationals (spectral radius < rho, so P exists by "
+            "Lyapunov's theorem)", "proved", "proved",
+            details={"spectral_radius": pytest.approx(a), "stein": "scipy's P failed the exact re-check"})
+
+
+def test_a_P_with_an_indefinite_stein_matrix_is_not_the_proof(monkeypatch):
+    """Ad = 0.5 I, rho = 0.8 with scipy answering P = diag(1, -1): P > 0 fails exactly, so the proof is the exact
+    Schur test, not that P."""
+    import uvsym.verify.lyapunov as lyapunov
+
+    monkeypatch.setattr(lyapunov, "solve_discrete_lyapunov", lambda A, Q: np.diag([1.0, -1.0]))
+    certificate = discrete_lyapunov_decrease("contracts", 0.5 * np.eye(2), 0.8, "one map")
+    assert certificate.status == "proved" and "stein" in certificate.details and certificate.margin is None
+
+
+@pytest.mark.parametrize("Ad, rho, message", [
+    (np.ones((2, 3)), 0.5, "Ad must be square, got 2x3"),
+    ([[np.nan]], 0.5, "Ad has entries that are not finite"),
+    (np.eye(2), 0.0, "rho must be positive, got 0.0"),
+    (np.eye(2), -0.5, "rho must be positive, got -0.5"),
+    (np.eye(2), "fast", "rho must be a number, got 'fast'"),
+    (np.eye(2), np.inf, "rho must be finite, got inf"),
+])
+def test_discrete_claims_name_the_argument_at_fault(Ad, rho, message):
+    with pytest.raises(VerificationError, match=re.escape(message)):
+        discrete_lyapunov_decrease("contracts", Ad, rho, "one map")
+
+
+@pytest.mark.parametrize("vertices, gamma, message", [
+    (np.eye(2), 0.5, "vertices must be a list of matrices, got one matrix (wrap it in a list)"),
+    ([], 0.5, "vertices must be a non-empty list of square matrices, got list"),
+    ("A", 0.5, "vertices must be a non-empty list of square matrices, got str"),
+    ([np.eye(2), np.eye(3)], 0.5, "vertices[1] must be 2x2 like vertices[0], got 3x3"),
+    ([np.eye(2), np.ones((2, 3))], 0.5, "vertices[1] must be 2x2 like vertices[0], got 2x3"),
+    ([np.eye(2), [[np.inf, 0.0], [0.0, 1.0]]], 0.5, "vertices[1] has entries that are not finite"),
+    ([-np.eye(2)], None, "gamma must be a number, got None"),
+    ([-np.eye(2)], np.nan, "gamma must be finite, got nan"),
+])
+def test_continuous_claims_name_the_argument_at_fault(vertices, gamma, message):
+    with pytest.raises(VerificationError, match=re.escape(message)):
+        lyapunov_decrease("decreases", vertices, gamma, "one matrix")
+
+
+def test_each_continuous_outcome_states_its_method_and_keeps_the_expected_label(solver_answer):
+    solver_answer(np.eye(2))
+    proved = lyapunov_decrease("V decreases", [MINUS_I, MINUS_I], 0.25, "two vertices", expected="refuted")
+    assert _timed(proved) == Certificate(
+        "V decreases", "two vertices", "LMI (cvxpy, Clarabel) at 2 vertices, re-checked by exact rational LDL^T",
+        "proved", "refuted", margin=1.0, details={"P": [[1.0, 0.0], [0.0, 1.0]]})
+    refuted = lyapunov_decrease("too fast", [MINUS_I], 1.5, "one matrix", expected="refuted")
+    assert _timed(refuted) == Certificate(
+        "too fast", "one matrix", "Routh-Hurwitz on det(sI - A - gamma I) of a vertex, in exact rationals: an "
+        "eigenvalue with real part >= -gamma", "refuted", "refuted", margin=pytest.approx(-0.5),
+        counterexample={"A": MINUS_I.tolist(), "gamma": 1.5, "eigenvalue_real": -1.0, "eigenvector_real": [1.0, 0.0],
+                        "exact_test": "Routh-Hurwitz"})
+    solver_answer([[7.0, 1.0], [1.0, 1.0 / 7.0]])
+    fallback = lyapunov_decrease("V decreases", [MINUS_I], 0.5, "one matrix", expected="checked")
+    assert _timed(fallback) == Certificate(
+        "V decreases", "one matrix", "Routh-Hurwitz on det(sI - A - gamma I) in exact rationals (A + gamma I "
+        "Hurwitz, so P exists by Lyapunov's theorem)", "proved", "checked",
+        details={"lmi": "the solver's P failed the exact re-check"})
+    solver_answer(None, "infeasible")
+    undecided = lyapunov_decrease("hull", [MINUS_I, 2 * MINUS_I], 0.5, "two vertices", expected="refuted")
+    assert _timed(undecided) == Certificate(
+        "hull", "two vertices", "LMI (cvxpy, Clarabel)", "inconclusive", "refuted",
+        reason="every vertex is stable at rate gamma (exact Routh-Hurwitz), but no common P: LMI status infeasible")
