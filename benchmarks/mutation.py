@@ -14,6 +14,11 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 - ``started``, ``seconds``, ``modules_requested``, the mutmut version (``--merge`` keeps the other modules of
   the last results, each with the ``started`` of its own run).
 
+``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests there and tests again only the mutants
+that were not killed (the tests kept there only add kills, so the result is that of a full run with the current
+tests on the source copied then). ``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests
+under the key ``before``.
+
 tests/mutation_equivalents.toml lists ``[[equivalent]]`` tables: ``mutant`` (mutmut's name), ``change`` (a line
 the mutant's diff adds, so a renumbered mutant is not excused by mistake) and ``reason`` (one line).
 """
@@ -65,26 +70,38 @@ def _toml_value(value) -> str:
     return json.dumps(value)
 
 
-def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str], tests_at: str | None) -> None:
-    """The working tree's files (tracked and untracked, ignored ones and ``without`` left out) in ``scratch``, the
-    tests as commit ``tests_at`` has them if given, with ``only_mutate`` narrowed to ``modules`` and test files
-    that do not exist dropped from the selection."""
-    folders = ["uvsym", "derivations"] + ([] if tests_at else ["tests"])
-    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", *folders],
-                            capture_output=True, text=True, check=True).stdout.split()
-    for name in listed + ["pyproject.toml"]:
-        if (ROOT / name).is_file() and name not in without:
-            (scratch / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(ROOT / name, scratch / name)
+def _copy_tests(destination: Path, without: list[str], tests_at: str | None) -> None:
+    """tests/ of the working tree (tracked and untracked, ignored ones and ``without`` left out), or of commit
+    ``tests_at``, into ``destination``/tests."""
     if tests_at:
         archive = subprocess.run(["git", "-C", str(ROOT), "archive", tests_at, "tests"], capture_output=True,
                                  check=True).stdout
         with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
-            tar.extractall(scratch, filter="data")
-    narrowed = {**config, "only_mutate": modules,
-                "pytest_add_cli_args_test_selection": [t for t in config["pytest_add_cli_args_test_selection"]
-                                                       if (scratch / t).exists()]}
-    section = "[tool.mutmut]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in narrowed.items())
+            tar.extractall(destination, filter="data")
+        return
+    _copy_listed(destination, ["tests"], without)
+
+
+def _copy_listed(destination: Path, folders: list[str], without: list[str]) -> None:
+    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-co", "--exclude-standard", *folders],
+                            capture_output=True, text=True, check=True).stdout.split()
+    for name in listed:
+        if (ROOT / name).is_file() and name not in without:
+            (destination / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(ROOT / name, destination / name)
+
+
+def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str], tests_at: str | None) -> None:
+    """The working tree's uvsym/, derivations/ and pyproject.toml in ``scratch``, its tests (or those of
+    ``tests_at``), ``only_mutate`` narrowed to ``modules``. A selected test file that is missing becomes an empty
+    one, so that the selection (which mutmut's cache is keyed on) stays the same when ``--again`` brings it."""
+    _copy_listed(scratch, ["uvsym", "derivations", "pyproject.toml"], [])
+    _copy_tests(scratch, without, tests_at)
+    for name in config["pytest_add_cli_args_test_selection"]:
+        if not (scratch / name).exists():
+            (scratch / name).write_text('"""Not in the tests measured (benchmarks/mutation.py)."""\n')
+    section = "[tool.mutmut]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in {**config,
+                                                                                     "only_mutate": modules}.items())
     text = (scratch / "pyproject.toml").read_text()
     text = re.sub(r"(?ms)^\[tool\.mutmut\]\n.*?(?=^\[)", lambda _: section + "\n", text)
     (scratch / "pyproject.toml").write_text(text)
@@ -146,23 +163,37 @@ def main(argv: list[str] | None = None) -> int:
                         help="take tests/ from this commit (to measure what the tests of an earlier commit kill)")
     parser.add_argument("--merge", action="store_true",
                         help="keep the modules and survivors of the last results that this run does not measure")
+    parser.add_argument("--again", type=Path, metavar="FOLDER",
+                        help="in a folder an earlier run kept (--keep), bring the current tests and test again only "
+                             "the mutants that were not killed (tests kept there only add kills)")
     parser.add_argument("--before", action="store_true",
                         help="record this run as the baseline (key 'before') and leave the last results as they are")
     args = parser.parse_args(argv)
     config = _config()
     available = configured_modules(config)
-    modules = available if not args.modules else [m for m in available if any(
-        fnmatch.fnmatch(m, p) or m == p for p in args.modules)]
+    if args.again:
+        kept = tomllib.loads((args.again / "pyproject.toml").read_text())["tool"]["mutmut"]["only_mutate"]
+        modules = [m for m in available if m in kept]
+    else:
+        modules = available if not args.modules else [m for m in available if any(
+            fnmatch.fnmatch(m, p) or m == p for p in args.modules)]
     if not modules:
         parser.error(f"--modules matches none of the configured modules: {', '.join(available)}")
     started, clock = datetime.now(timezone.utc).isoformat(timespec="seconds"), time.perf_counter()
-    scratch = args.keep or Path(tempfile.mkdtemp(prefix="uvsym-mutation-"))
+    scratch = args.again or args.keep or Path(tempfile.mkdtemp(prefix="uvsym-mutation-"))
     try:
         scratch.mkdir(parents=True, exist_ok=True)
-        _copy_tree(scratch, config, modules, args.without, args.tests_at)
+        names = []
+        if args.again:
+            for destination in (scratch, scratch / "mutants"):
+                _copy_tests(destination, args.without, args.tests_at)
+            names = sorted(n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
+                           if s not in KILLED)
+        else:
+            _copy_tree(scratch, config, modules, args.without, args.tests_at)
         mutmut = str(Path(sys.executable).parent / "mutmut")
         env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
-        run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children)],
+        run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children), *names],
                              cwd=scratch, env=env, capture_output=True, text=True)
         (scratch / "mutmut-run.log").write_text(run.stdout + run.stderr)
         seconds = time.perf_counter() - clock
@@ -171,11 +202,12 @@ def main(argv: list[str] | None = None) -> int:
         outcomes = _outcomes(scratch, modules)
         for module, statuses in outcomes.items():
             per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
-            per_module[module].update(run_seconds=seconds, tests_at=args.tests_at, tests_left_out=args.without)
+            per_module[module].update(run_seconds=seconds, tests_at=args.tests_at, tests_left_out=args.without,
+                                      retested=sum(n.startswith(module[:-3].replace("/", ".") + ".") for n in names))
             survivors += left
             justified |= excused
     finally:
-        if args.keep is None:
+        if args.keep is None and args.again is None:
             shutil.rmtree(scratch, ignore_errors=True)
     measured = {name for statuses in outcomes.values() for name in statuses}
     prefixes = tuple(m[:-3].replace("/", ".") + "." for m in modules)
