@@ -13,7 +13,7 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-__all__ = ["EVENTS", "Event", "events_json", "write_events"]
+__all__ = ["EVENTS", "Event", "events_json", "write_events", "write_events_records"]
 
 EVENTS = ("detected", "isolated", "identified", "cleared", "ambiguous", "unexcited")
 
@@ -42,6 +42,11 @@ def events_json(events: list[Event]) -> str:
 
 def write_events(events: list[Event], path) -> Path:
     """Write the log to ``path`` (JSON); returns the path."""
+    return write_events_records([e.as_dict() for e in events], path)
+
+
+def write_events_records(records: list[dict], path) -> Path:
+    """Write a log already in its JSON form (``SimResult.events``) to ``path``; returns the path."""
     path = Path(path)
-    path.write_text(events_json(events) + "\n")
+    path.write_text(json.dumps(records, indent=1) + "\n")
     return path

@@ -54,6 +54,8 @@ class RegressorBank:
         self.phi = (1 + dt * lam / 2) / (1 - dt * lam / 2)  # per mode
         self.gamma = -lam * dt / (1 - dt * lam / 2)
         self.Phi = self.V @ np.diag(self.phi) @ self.V_inv
+        self._effects: dict[tuple, tuple] = {}  # exact fault effects computed so far (see exact)
+        self._tau_maps: dict[int, object] = {}  # the force model mapped over so many samples
         self._state = None  # per mode: filter state (lfilter zi) and the last raw regressor
         self._last = None
         self.r = np.zeros((0, self.n))
@@ -104,20 +106,41 @@ class RegressorBank:
         ``c = F[D(theta) - theta D']`` and ``phi = F[D']``, filtered from a zero state at the window's first
         sample (the free response is projected out of every fit).
         """
+        D, slope = self._effect(rows, actuator, kind, theta)
+        active = (rows >= onset)[:, None]
+        return self._filter(active * (D - theta * slope)), self._filter(active * slope)
+
+    def _effect(self, rows: np.ndarray, actuator: int, kind, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """(D(theta), D'(theta)) on the contiguous ``rows``, each (len(rows), n); kept per (a, kind, theta)
+        so that later windows evaluate only their new samples."""
+        key = (actuator, kind.name, theta)
+        first, D, slope = self._effects.get(key, (rows[0], np.zeros((0, self.n)), np.zeros((0, self.n))))
+        if rows[0] < first:
+            first, D, slope = rows[0], np.zeros((0, self.n)), np.zeros((0, self.n))
+        have = first + len(D)
+        if rows[-1] >= have:
+            D_new, slope_new = self._evaluate(np.arange(have, rows[-1] + 1), actuator, kind, theta)
+            D, slope = np.concatenate([D, D_new]), np.concatenate([slope, slope_new])
+            if len(self._effects) > 64:
+                self._effects.clear()
+            self._effects[key] = (first, D, slope)
+        return D[rows - first], slope[rows - first]
+
+    def _evaluate(self, rows: np.ndarray, actuator: int, kind, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """D and its central-difference slope in the size on ``rows`` (the force model evaluated 3 times a row)."""
         n, length = self.n, len(rows)
         y, u_e = self.y[rows], self.u_e[rows]
         step = 1e-6 * max(1.0, abs(theta))
         u = np.repeat(u_e[None], 3, axis=0)  # healthy, theta - step, theta + step
         u[1, :, actuator] = kind.deliver(u_e[:, actuator], theta - step)
         u[2, :, actuator] = kind.deliver(u_e[:, actuator], theta + step)
+        if 3 * length not in self._tau_maps:
+            self._tau_maps[3 * length] = self.model.tau.raw.map(3 * length)
         eta, nu = np.tile(y[:, :n].T, 3), np.tile(y[:, n:].T, 3)
-        tau = np.asarray(self.model.tau.raw.map(3 * length)(eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
+        tau = np.asarray(self._tau_maps[3 * length](eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
         tau = tau.T.reshape(3, length, n)
         low, high = tau[1] - tau[0], tau[2] - tau[0]
-        active = (rows >= onset)[:, None]
-        D = active * (low + high) / 2
-        slope = active * (high - low) / (2 * step)
-        return self._filter(D - theta * slope), self._filter(slope)
+        return (low + high) / 2, (high - low) / (2 * step)
 
     def _filter(self, series: np.ndarray) -> np.ndarray:
         """``series`` (L, n) through the observer's filter from a zero state (trapezoidal inputs)."""

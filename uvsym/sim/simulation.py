@@ -198,10 +198,26 @@ def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...], dt: float) ->
 
 def simulate_scenario(scenario: Scenario, *, method: str = "fast", supervisor: Supervisor | None = None,
                       progress=None, **options) -> SimResult:
-    """Run a validated :class:`Scenario`; keyword options go to :func:`simulate` (e.g. substeps)."""
+    """Run a validated :class:`Scenario`; keyword options go to :func:`simulate` (e.g. substeps).
+
+    A scenario with a [diagnosis] table runs its :class:`~uvsym.diagnosis.ActuatorDiagnosis`: in the
+    loop when it corrects the commands, else on the finished record (the same decisions, faster);
+    the result's ``events`` hold its decision log (unless ``supervisor`` replaces it).
+    """
+    diagnosis = None
+    if scenario.diagnosis is not None and supervisor is None:
+        from uvsym.diagnosis.run import diagnosis_for  # the diagnosis package builds on this module
+
+        diagnosis = diagnosis_for(scenario)
+        supervisor = diagnosis if scenario.diagnosis.correct else None
     result = simulate(scenario.model, scenario.controller, **scenario_arguments(scenario), supervisor=supervisor,
                       method=method, progress=progress, **options)
-    return SimResult(result.t, result.signals, {"scenario": scenario.name, **result.meta})
+    meta = {"scenario": scenario.name, **result.meta}
+    if diagnosis is not None:
+        if supervisor is None:
+            diagnosis.update(result.t, {name: result[name].values for name in diagnosis.reads})
+        meta["events"] = [event.as_dict() for event in diagnosis.events]
+    return SimResult(result.t, result.signals, meta)
 
 
 def scenario_arguments(scenario: Scenario, observers: tuple[Observer, ...] | None = None) -> dict:
