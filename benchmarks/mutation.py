@@ -14,13 +14,11 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 - ``started``, ``seconds``, ``modules_requested``, the mutmut version (``--merge`` keeps the other modules of
   the last results, each with the ``started`` of its own run).
 
-``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests there and tests again only the mutants
-that were not killed (the tests kept there only add kills, so the result is that of a full run with the current
-tests on the source copied then). ``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests
-under the key ``before``.
-
-tests/mutation_equivalents.toml lists ``[[equivalent]]`` tables: ``mutant`` (mutmut's name), ``change`` (a line
-the mutant's diff adds, so a renumbered mutant is not excused by mistake) and ``reason`` (one line).
+``--sample N`` tests N mutants of each module drawn at random (seed 0), an estimate (``sample`` in each module's
+record; the others count as not checked). ``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current
+tests there and tests again only the mutants that were not killed (the tests kept there only add kills, so the
+result is that of a full run with the current tests on the source copied then). ``--before --tests-at COMMIT``
+records a baseline with an earlier commit's tests under the key ``before``.
 """
 
 from __future__ import annotations
@@ -31,6 +29,7 @@ import importlib.metadata
 import io
 import json
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -132,6 +131,11 @@ def _diff(scratch: Path, name: str) -> str:
                      and not line.startswith(("+++", "---")))
 
 
+def _dotted(module: str) -> str:
+    """uvsym/verify/lyapunov.py -> "uvsym.verify.lyapunov." (how mutmut's mutant names start)."""
+    return module[:-3].replace("/", ".") + "."
+
+
 def _tally(scratch: Path, module: str, statuses: dict[str, str], equivalents: dict[str, dict],
            started: str) -> tuple[dict, list[dict], set[str]]:
     """(counts of one module, its unjustified survivors with their diffs, the equivalents that excused one)."""
@@ -166,6 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--again", type=Path, metavar="FOLDER",
                         help="in a folder an earlier run kept (--keep), bring the current tests and test again only "
                              "the mutants that were not killed (tests kept there only add kills)")
+    parser.add_argument("--sample", type=int, metavar="N",
+                        help="test N mutants of each module drawn at random (seed 0): an estimate, not a full run")
     parser.add_argument("--before", action="store_true",
                         help="record this run as the baseline (key 'before') and leave the last results as they are")
     args = parser.parse_args(argv)
@@ -193,6 +199,13 @@ def main(argv: list[str] | None = None) -> int:
             _copy_tree(scratch, config, modules, args.without, args.tests_at)
         mutmut = str(Path(sys.executable).parent / "mutmut")
         env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+        if args.sample:  # generate the mutants and the test statistics, test none, then draw the sample
+            subprocess.run(["nice", "-n", "15", mutmut, "run", "no-mutant-is-named-so*"], cwd=scratch, env=env,
+                           capture_output=True, text=True)
+            draw = random.Random(0)
+            for statuses in _outcomes(scratch, modules).values():
+                pending = sorted(n for n, s in statuses.items() if s not in KILLED | {"survived"})
+                names += sorted(draw.sample(pending, min(args.sample, len(pending))))
         run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children), *names],
                              cwd=scratch, env=env, capture_output=True, text=True)
         (scratch / "mutmut-run.log").write_text(run.stdout + run.stderr)
@@ -202,15 +215,16 @@ def main(argv: list[str] | None = None) -> int:
         outcomes = _outcomes(scratch, modules)
         for module, statuses in outcomes.items():
             per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
-            per_module[module].update(run_seconds=seconds, tests_at=args.tests_at, tests_left_out=args.without,
-                                      retested=sum(n.startswith(module[:-3].replace("/", ".") + ".") for n in names))
+            per_module[module].update(sample=args.sample, run_seconds=seconds, tests_at=args.tests_at,
+                                      tests_left_out=args.without,
+                                      retested=sum(n.startswith(_dotted(module)) for n in names))
             survivors += left
             justified |= excused
     finally:
         if args.keep is None and args.again is None:
             shutil.rmtree(scratch, ignore_errors=True)
     measured = {name for statuses in outcomes.values() for name in statuses}
-    prefixes = tuple(m[:-3].replace("/", ".") + "." for m in modules)
+    prefixes = tuple(_dotted(m) for m in modules)
     stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified)
     saved = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     previous = saved.get("before", {}) if args.before else saved
