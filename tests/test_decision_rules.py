@@ -166,6 +166,21 @@ def test_without_correction_the_supervisor_only_identifies():
     assert diagnosis.identified["X"].value == pytest.approx(-4.0, abs=1e-9)
 
 
+def test_a_three_dof_vehicle_reads_its_channels_from_rows_x_y_and_n():
+    """Otter (3 DOF, thrusters T_L, T_R; B rows X = (1, 1), N = (0.395, -0.395) at 1 m/s): a 10 N bias on T_L
+    delivers X = tau_d + 10 and N = 3.95; solving those rows gives T_L + 10 N and T_R unchanged (bias 0)."""
+    model = vehicle("otter3dof")
+    diagnosis = FaultDiagnosis(model, {"bias": (None, None)}, period=0.3)
+    diagnosis.isolator = StubIsolator([{"X": ("bias", 10.0), "Y": ("healthy", 0.0), "N": ("bias", 3.95)}])
+    signals = {"y": np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], (3, 1)), "u_expected": np.tile([50.0, 50.0], (3, 1)),
+               "f_hat/bias": np.zeros((3, 3)), "tau_desired": np.tile([100.0, 0.0, 0.0], (3, 1))}
+    correction = diagnosis.update(T[:3], signals)
+    assert diagnosis.identified["T_L"].kind == "bias" and diagnosis.identified["T_L"].value == pytest.approx(10.0)
+    assert diagnosis.identified["T_R"].value == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose(correction.o, [-10.0, 0.0], atol=1e-9)
+    assert diagnosis.decided and diagnosis.isolation_time_s == T[2]
+
+
 class CorrectOnce:
     """A supervisor that returns one correction (add 5 N to the thruster command) at its first check."""
 
