@@ -241,7 +241,8 @@ def test_metrics_of_a_hand_written_event_log():
               _event(13.0, "ambiguous", "X|delta_ru")]
     metrics = event_metrics(TRUTH, events[::-1])                # order of the list does not matter
     assert metrics == {"events": 9, "detected": True, "detection_delay_s": pytest.approx(0.8),
-                       "isolated_actuator": "X", "isolated_kind": "bias", "isolation_delay_s": pytest.approx(2.5),
+                       "isolated_actuator": "X", "isolated_kind": "bias", "isolated_actuators": "X",
+                       "isolation_delay_s": pytest.approx(2.5),
                        "identified_value": 10.4, "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
                        "ambiguous": True, "unexcited": False}
 
@@ -258,6 +259,19 @@ def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
     metrics = event_metrics(healthy, [_event(3.0, "detected"), _event(4.0, "isolated", "X", "bias")])
     assert metrics["false_alarms"] == 2 and metrics["detected"] is False and metrics["detection_delay_s"] is None
     assert metrics["isolated_actuator"] == "X"
+
+
+def test_the_final_isolation_is_the_last_one_standing():
+    # a diagnosis that watches each actuator holds several isolations; clearing the last leaves the one before
+    events = [_event(6.0, "isolated", "X", "bias"), _event(7.0, "isolated", "delta_ru", "proportional"),
+              _event(8.0, "isolated", "delta_rd", "proportional"), _event(9.0, "cleared", "delta_rd"),
+              _event(10.0, "isolated", "X", "constant")]  # X again: now the latest
+    metrics = event_metrics(TRUTH, events)
+    assert (metrics["isolated_actuator"], metrics["isolated_kind"]) == ("X", "constant")
+    assert metrics["isolated_actuators"] == "delta_ru|X" and metrics["isolation_delay_s"] == pytest.approx(1.0)
+    metrics = event_metrics(TRUTH, events[:4])
+    assert (metrics["isolated_actuator"], metrics["isolated_actuators"]) == ("delta_ru", "X|delta_ru")
+    assert event_metrics(TRUTH, events + [_event(11.0, "cleared")])["isolated_actuators"] is None
 
 
 def test_truth_and_path_error_of_a_run():

@@ -25,7 +25,7 @@ METRIC_COLUMNS = {
     "n_faults": "int64", "true_actuator": "string", "true_sensor": "string", "true_kind": "string",
     "true_value": "float64", "onset_s": "float64", "end_s": "float64",
     "events": "int64", "detected": "bool", "detection_delay_s": "float64", "isolated_actuator": "string",
-    "isolated_kind": "string",
+    "isolated_kind": "string", "isolated_actuators": "string",
     "isolation_delay_s": "float64", "identified_value": "float64", "size_error_rel": "float64",
     "false_alarms": "int64", "ambiguous": "bool", "unexcited": "bool", "path_error_rms_m": "float64",
     "wall_s": "float64",
@@ -56,7 +56,9 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
 
     detected / detection_delay_s: a "detected" event in the fault's window, the first one's time
     after the onset (s); isolated_actuator / isolated_kind: the last "isolated" decision not
-    cleared by the end of the run (a "cleared" naming no actuator, or that one, clears it);
+    cleared by the end of the run (a "cleared" naming its actuator, or none, clears it), and
+    isolated_actuators: every actuator isolated and not cleared then, in the order of isolation,
+    joined by "|";
     isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
     identified_value: the last "identified" value in the window for it (or naming none);
     size_error_rel: |identified - true| / |true| (None when true is 0); false_alarms: alarms
@@ -75,12 +77,16 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     isolations = [e for e in events if e["event"] == "isolated" and in_window(e) and e.get("actuator") == target]
     identified = [e for e in events if e["event"] == "identified" and in_window(e)
                   and e.get("actuator") in (target, None) and e.get("value") is not None]
-    decision = None
+    standing: dict = {}  # actuator -> its isolation not cleared since (a diagnosis may hold several)
     for e in events:
         if e["event"] == "isolated":
-            decision = e
-        elif e["event"] == "cleared" and decision is not None and e.get("actuator") in (None, decision.get("actuator")):
-            decision = None
+            standing.pop(e.get("actuator"), None)
+            standing[e.get("actuator")] = e
+        elif e["event"] == "cleared":
+            if e.get("actuator") is None:
+                standing.clear()
+            standing.pop(e.get("actuator"), None)
+    decision = list(standing.values())[-1] if standing else None
     value = float(identified[-1]["value"]) if identified else None
     true_value = true["true_value"]
     return {
@@ -89,6 +95,7 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "detection_delay_s": detections[0]["t"] - onset if detections else None,
         "isolated_actuator": None if decision is None else decision.get("actuator"),
         "isolated_kind": None if decision is None else decision.get("kind"),
+        "isolated_actuators": "|".join(str(a) for a in standing) or None,
         "isolation_delay_s": isolations[0]["t"] - onset if isolations else None,
         "identified_value": value,
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
