@@ -146,19 +146,19 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     z_disc, u_cmd, out = ca.densify(z_disc), ca.densify(u_cmd), ca.densify(out)
     discrete = ca.Function("closed_loop_discrete", [z, w], [z_disc, u_cmd, out], ["z", "w"], ["z_disc", "u_cmd", "out"])
 
-    s, uc, env, ts = ca.SX.sym("s", n_s), ca.SX.sym("u_cmd", m), ca.SX.sym("env", 2), ca.SX.sym("t")
-    applied = apply_actuator_faults(s[n:], ts, actuator_faults)
-    s_dot = ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(s[n:], uc))
-    plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
+    def s_dot(s, applied, u_cmd, env):
+        """[x; a]' with the actuators delivering ``applied`` while they follow ``u_cmd``."""
+        return ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(s[n:], u_cmd))
 
+    s, uc, env, ts = ca.SX.sym("s", n_s), ca.SX.sym("u_cmd", m), ca.SX.sym("env", 2), ca.SX.sym("t")
+    plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot(s, apply_actuator_faults(s[n:], ts, actuator_faults),
+                                                                 uc, env)], ["s", "u_cmd", "env", "t"], ["s_dot"])
     half = dt / (2 * substeps)
 
     def stage_ode(s, u_cmd, env, offset):
         """s_dot at ``offset`` s into the sample (rk4 runs from 0 here), faults from w's stage column."""
-        j = round(offset / half)
-        a = s[n:]
-        applied = a + (faults[:, j] * a + faults[:, stages + j])
-        return ca.vertcat(model.f(s[:n], applied, env), model.actuator_rate(a, u_cmd))
+        j, a = round(offset / half), s[n:]
+        return s_dot(s, a + (faults[:, j] * a + faults[:, stages + j]), u_cmd, env)
 
     env_step = ca.vertcat(V_c, beta_c) if current is None else ca.DM(current)
     s_next = rk4(stage_ode, z[:n_s], dt, substeps, u_cmd, env_step)
