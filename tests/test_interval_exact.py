@@ -199,3 +199,57 @@ def test_truth_clean_and_zero_tests():
     assert lo.tolist() == [-np.inf, 1.0] and hi.tolist() == [2.0, np.inf]
     assert ia.holds_zero((np.array([-1.0, 0.0, 0.5]), np.array([1.0, 2.0, 1.0]))).tolist() == [True, True, False]
     assert ia.is_zero((np.array([0.0, 0.0]), np.array([0.0, 1.0]))).tolist() == [True, False]
+
+
+def test_overflowing_sums_and_doublings_keep_a_finite_bound_on_the_finite_side():
+    big = np.finfo(float).max
+    lo, hi = ia.signed_sum(box(1e308), box(1e308), 1.0)
+    assert (lo[0], hi[0]) == (big, np.inf)  # 2e308 is above every double: the largest one is a lower bound
+    lo, hi = ia.signed_sum(box(-1e308), box(1e308), -1.0)
+    assert (lo[0], hi[0]) == (-np.inf, -big)
+    lo, hi = ia.twice((np.array([big, -big, 1.0]), np.array([big, -big, 2.0])))
+    assert lo.tolist() == [big, -np.inf, 2.0] and hi.tolist() == [np.inf, -big, 4.0]
+
+
+def test_products_and_quotients_with_unbounded_or_negative_boxes():
+    lo, hi = ia.mul((np.array([0.0]), np.array([1.0])), (np.array([1.0]), np.array([np.inf])))
+    assert -math.ulp(0.0) <= lo[0] <= 0.0 and hi[0] == np.inf  # 0 * inf counts as 0, not NaN
+    lo, hi = ia.div((np.array([1.0]), np.array([2.0])), (np.array([-4.0]), np.array([-2.0])))
+    assert -1.0 - 2 * math.ulp(1.0) <= lo[0] <= -1.0 and -0.25 <= hi[0] <= -0.25 + 2 * math.ulp(0.25)
+    lo, hi = ia.power((np.array([-1.0]), np.array([2.0])), -2.0)  # 1 / x^2 over a box holding 0
+    assert (lo[0], hi[0]) == (-np.inf, np.inf)
+
+
+def test_fractional_powers_clip_the_box_at_zero():
+    lo, hi = ia.power((np.array([-1.0]), np.array([4.0])), 2.5)
+    assert -math.ulp(0.0) * 8 <= lo[0] <= 0.0 and 32.0 <= hi[0] <= 32.0 + 8 * math.ulp(32.0)
+    lo, hi = ia.power((np.array([0.0]), np.array([4.0])), -1.5)
+    assert 0.125 - 8 * math.ulp(0.125) <= lo[0] <= 0.125 and hi[0] == np.inf
+
+
+def test_far_from_zero_a_sine_gets_the_whole_range():
+    lo, hi = ia.periodic((np.array([1e7]), np.array([1e7 + 0.1])), np.sin, math.pi / 2, -math.pi / 2)
+    assert (lo[0], hi[0]) == (-1.0, 1.0)
+    lo, hi = ia.periodic((np.array([-1e7 - 0.1]), np.array([-1e7])), np.cos, 0.0, math.pi)
+    assert (lo[0], hi[0]) == (-1.0, 1.0)
+
+
+def test_even_functions_take_the_larger_end_and_zero_inside():
+    lo, hi = ia.even((np.array([-3.0, 1.0, -2.0]), np.array([1.0, 2.0, -1.0])), np.square)
+    assert lo.tolist() == [0.0, 1.0, 1.0] and hi.tolist() == [9.0, 4.0, 4.0]
+
+
+def test_exact_zeros_replace_the_bounds_only_where_an_operand_is_zero():
+    result = (np.array([-1.0, -1.0, -1.0]), np.array([1.0, 1.0, 1.0]))
+    a = (np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 1.0]))
+    b = (np.array([2.0, 2.0, 0.0]), np.array([3.0, 3.0, 0.0]))
+    lo, hi = ia.exact_zeros(result, a, b, value=1.0)
+    assert lo.tolist() == [1.0, -1.0, 1.0] and hi.tolist() == [1.0, 1.0, 1.0]
+    lo, hi = ia.exact_zeros(result, a)
+    assert lo.tolist() == [0.0, -1.0, -1.0] and hi.tolist() == [0.0, 1.0, 1.0]
+
+
+def test_indicators_of_decided_and_undecided_boxes():
+    (lo, hi), undecided = ia.indicator(np.array([True, False, False]), np.array([False, True, False]))
+    assert lo.tolist() == [1.0, 0.0, 0.0] and hi.tolist() == [1.0, 0.0, 1.0]
+    assert undecided.tolist() == [False, False, True]
