@@ -169,7 +169,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="keep the modules and survivors of the last results that this run does not measure")
     parser.add_argument("--again", type=Path, metavar="FOLDER",
                         help="in a folder an earlier run kept (--keep), bring the current tests and test again only "
-                             "the mutants that were not killed (tests kept there only add kills)")
+                             "the mutants that were not killed (tests kept there only add kills); with --sample, "
+                             "only those of the sample tested there")
     parser.add_argument("--sample", type=int, metavar="N",
                         help="test N mutants of each module drawn at random (seed 0): an estimate, not a full run")
     parser.add_argument("--before", action="store_true",
@@ -193,13 +194,14 @@ def main(argv: list[str] | None = None) -> int:
         if args.again:
             for destination in (scratch, scratch / "mutants"):
                 _copy_tests(destination, args.without, args.tests_at)
+            again = {"survived", "no tests", "suspicious"} | (set() if args.sample else {"not checked"})
             names = sorted(n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
-                           if s not in KILLED)
+                           if s in again)
         else:
             _copy_tree(scratch, config, modules, args.without, args.tests_at)
         mutmut = str(Path(sys.executable).parent / "mutmut")
         env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
-        if args.sample:  # generate the mutants and the test statistics, test none, then draw the sample
+        if args.sample and not args.again:  # generate the mutants and test statistics, test none, draw the sample
             subprocess.run(["nice", "-n", "15", mutmut, "run", "no-mutant-is-named-so*"], cwd=scratch, env=env,
                            capture_output=True, text=True)
             draw = random.Random(0)
