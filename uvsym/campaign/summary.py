@@ -81,6 +81,10 @@ def _shown(value) -> str:
     return "-" if value is None else f"{value:.3g}"
 
 
+def _label(value) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
 def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
     labels_true = list(summary["confusion"])
     labels_isolated = sorted({k for cell in summary["confusion"].values() for k in cell})
@@ -96,21 +100,24 @@ def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
     ax.set_xlabel("isolated actuator")
     ax.set_ylabel("true fault")
     ax.set_title("confusion matrix (runs)")
+    fig.tight_layout()
     save_svg(fig, folder / "confusion.svg")
 
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
-    points = [p for p in summary["roc"] if p["detection_probability"] is not None and p["false_alarm_rate"] is not None]
-    ax.plot([p["false_alarm_rate"] for p in points], [p["detection_probability"] for p in points], "o-")
-    for p in points:
-        label = ", ".join(f"{k} = {v}" for k, v in p["group"].items())
-        if label:
-            ax.annotate(label, (p["false_alarm_rate"], p["detection_probability"]), fontsize=7)
+    points = sorted((p["false_alarm_rate"], p["detection_probability"], ", ".join(map(_label, p["group"].values())))
+                    for p in summary["roc"]
+                    if p["detection_probability"] is not None and p["false_alarm_rate"] is not None)
+    ax.plot([p[0] for p in points], [p[1] for p in points], "o-")
+    for x, y, label in points:
+        ax.annotate(label, (x, y), xytext=(-4 if x > 0.5 else 4, 4), textcoords="offset points", fontsize=8,
+                    ha="right" if x > 0.5 else "left")
     ax.plot([0, 1], [0, 1], ":", color="grey")
     ax.set_xlim(-0.02, 1.02)
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("false-alarm rate")
     ax.set_ylabel("detection probability")
     ax.set_title("ROC" + (f" over {', '.join(summary['roc_by'])}" if summary["roc_by"] else ""))
+    fig.tight_layout()
     save_svg(fig, folder / "roc.svg")
 
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
@@ -122,6 +129,7 @@ def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
             ax.text(0.5, 0.5, "none", ha="center", va="center", transform=ax.transAxes)
         ax.set_xlabel(column.replace("_s", " (s)").replace("_", " "))
         ax.set_ylabel("runs")
+    fig.tight_layout()
     save_svg(fig, folder / "delays.svg")
 
 
