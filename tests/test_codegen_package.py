@@ -285,3 +285,24 @@ def test_a_package_of_empty_arguments_compiles_without_an_unused_finite_check(tm
                            str(tmp_path / "src" / "empty.c"), "-o", str(tmp_path / "empty.o")], capture_output=True,
                           text=True)
     assert done.returncode == 0, done.stderr
+
+
+def test_exported_functions_and_package_names_are_checked(tmp_path):
+    x, m = ca.SX.sym("x", 2), ca.SX.sym("m", 2, 2)
+    twice = ca.Function("twice", [x], [2 * x], ["x"], ["y"])
+    with pytest.raises(CodegenError, match=r"twice: give one unit per input \(1\) and output \(1\)"):
+        Exported(twice, (), ("y",), "doubles x")
+    with pytest.raises(CodegenError, match=r"twice: give one unit per input \(1\) and output \(1\)"):
+        Exported(twice, ("x",), ("y", "z"), "doubles x")
+    with pytest.raises(CodegenError, match="first: input m must be a dense column vector"):
+        Exported(ca.Function("first", [m], [m[0, 0]], ["m"], ["y"]), ("m",), ("y",), "reads m")
+    with pytest.raises(CodegenError, match="twice: argument y has 2 entries, its units 1"):
+        Exported(twice, ("x",), (Entries("y", ("a",), ("m",)),), "doubles x")
+    exported = Exported(twice, ("x",), ("y",), "doubles x")
+    with pytest.raises(CodegenError, match="'2pkg' is not a C identifier"):
+        write_package(tmp_path / "a", [exported], "2pkg")
+    with pytest.raises(CodegenError, match="package pkg: function names must differ; given twice, twice"):
+        write_package(tmp_path / "b", [exported, exported], "pkg")
+    with pytest.raises(CodegenError, match="unknown precision 'half'; known: double, float"):
+        write_package(tmp_path / "c", [exported], "pkg", "half")
+    assert not any((tmp_path / name).exists() for name in "abc")  # refused before anything is written
