@@ -20,7 +20,7 @@ from uvsym.campaign.dotted import parse_path, set_path
 from uvsym.cli import main
 from uvsym.errors import CampaignError, CampaignSizeError, ExecutorError, PathError
 from uvsym.sim.result import Signal, SimResult
-from uvsym.sim.scenario import load_scenario
+from uvsym.sim.scenario import load_scenario, parse_scenario, read_scenario_file, shipped_scenarios
 
 GRID = """
 name = "grid"
@@ -279,6 +279,18 @@ def test_truth_and_path_error_of_a_run():
     scenario = load_scenario("docking_faults")
     assert truth(scenario) == {"n_faults": 3, "true_actuator": "X", "true_sensor": None, "true_kind": "bias",
                                "true_value": 13.0, "onset_s": 0.0, "end_s": None}
+    # sensor noise over the whole run is the sensors' specification: the fault is the later actuator one
+    table = read_scenario_file(shipped_scenarios()["docking_faults"])
+    noise = {"sensor": "u", "kind": "noise", "value": 0.01}
+    table["faults"] = [noise, {"actuator": "delta_e", "kind": "bias", "value": 0.05, "onset": 8.0, "end": 20.0}]
+    assert truth(parse_scenario(table)) == {"n_faults": 1, "true_actuator": "delta_e", "true_sensor": None,
+                                            "true_kind": "bias", "true_value": 0.05, "onset_s": 8.0, "end_s": 20.0}
+    table["faults"] = [noise, noise | {"onset": 3.0}]  # noise that starts later is a fault
+    assert truth(parse_scenario(table)) | {"true_value": None} == {
+        "n_faults": 1, "true_actuator": None, "true_sensor": "u", "true_kind": "noise", "true_value": None,
+        "onset_s": 3.0, "end_s": None}
+    table["faults"] = [noise]
+    assert truth(parse_scenario(table))["n_faults"] == 0
     result = SimResult(np.array([0.0, 1.0]), {"reference": Signal(np.array([[0.0, 3.0], [0.0, 4.0]]),
                                                                   ("psi_ref", "cross_track"), ("rad", "m"))})
     assert run_metrics(scenario, result, [])["path_error_rms_m"] == pytest.approx(math.sqrt((9 + 16) / 2))
@@ -302,7 +314,6 @@ def test_a_tiny_campaign_on_local_processes(local_run):
     assert all(r["status"] == "ok" and r["true_actuator"] == "X" and r["onset_s"] == 1.0 for r in rows)
     assert all(r["final_u_mps"] > 1.0 for r in rows)  # the hook's column: near the 1.5 m/s reference
     # the path error is the RMS cross-track error of the same run made directly
-    from uvsym.sim.scenario import parse_scenario
     from uvsym.sim.simulation import simulate_scenario
 
     direct = simulate_scenario(parse_scenario(campaign.runs[0].scenario), compiled=False)

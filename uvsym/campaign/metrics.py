@@ -4,9 +4,11 @@ Events are dicts ``{"t": s, "event": "detected" | "isolated" | "identified" | "c
 "ambiguous" | "unexcited", "actuator": label or None, "kind": kind or None, "value": number or
 None}`` (for "ambiguous" the actuator is the candidates joined by "|").
 
-The run's fault is its earliest (actuator faults before sensor faults at equal onsets); its
-window runs from the onset to the first "cleared" event at or after its end (a fault without an
-end lasts the run). An alarm (detected, isolated, identified) outside the window, or in a run
+The run's fault is its earliest (actuator faults before sensor faults at equal onsets); sensor
+noise acting for the whole run is the sensors' specification, not a fault (as for the diagnosis,
+whose noise levels it sets), so a run with only such noise has no fault. The fault's window runs
+from the onset to the first "cleared" event at or after its end (a fault without an end lasts
+the run). An alarm (detected, isolated, identified) outside the window, or in a run
 without a fault, is a false alarm.
 """
 
@@ -33,13 +35,15 @@ METRIC_COLUMNS = {
 
 
 def truth(scenario) -> dict:
-    """n_faults and the run's fault: true_actuator or true_sensor (label), true_kind, true_value,
-    onset_s and end_s (None when it lasts the run); None throughout without a fault."""
+    """n_faults (whole-run sensor noise not counted: module docstring) and the run's fault:
+    true_actuator or true_sensor (label), true_kind, true_value, onset_s and end_s (None when it
+    lasts the run); None throughout without a fault."""
     model = scenario.model
     faults = [(f.profile.onset, 0, i, model.input_labels[f.actuator], None, f)
               for i, f in enumerate(scenario.actuator_faults)]
     faults += [(f.profile.onset, 1, i, None, model.state_labels[f.channel], f)
-               for i, f in enumerate(scenario.sensor_faults)]
+               for i, f in enumerate(scenario.sensor_faults)
+               if not (f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end))]
     row = {"n_faults": len(faults), "true_actuator": None, "true_sensor": None, "true_kind": None,
            "true_value": None, "onset_s": None, "end_s": None}
     if faults:
