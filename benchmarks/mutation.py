@@ -106,6 +106,17 @@ def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[st
     (scratch / "pyproject.toml").write_text(text)
 
 
+def _current_timeouts(scratch: Path, config: dict) -> None:
+    """The kept run's [tool.mutmut] with the current timeouts (its test selection and options stay: mutmut drops
+    every cached verdict when those change)."""
+    text = (scratch / "pyproject.toml").read_text()
+    for key in ("timeout_multiplier", "timeout_constant"):
+        text = re.sub(rf"(?m)^{key} = .*\n", "", text)
+        if key in config:
+            text = text.replace("[tool.mutmut]\n", f"[tool.mutmut]\n{key} = {_toml_value(config[key])}\n", 1)
+    (scratch / "pyproject.toml").write_text(text)
+
+
 def _equivalents() -> list[dict]:
     if not EQUIVALENTS.exists():
         return []
@@ -194,7 +205,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.again:
             for destination in (scratch, scratch / "mutants"):
                 _copy_tests(destination, args.without, args.tests_at)
-            again = {"survived", "no tests", "suspicious"} | (set() if args.sample else {"not checked"})
+            _current_timeouts(scratch, config)
+            again = {"survived", "no tests", "suspicious", "timeout"} | (set() if args.sample else {"not checked"})
             names = sorted(n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
                            if s in again)
         else:
