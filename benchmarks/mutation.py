@@ -248,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         stale = sorted(set(stale) | {n for n in previous.get("stale_equivalents", []) if not n.startswith(prefixes)})
     rates = [m["kill_rate"] for m in per_module.values() if m["kill_rate"] is not None]
     results = {"started": started, "seconds": seconds, "mutmut": importlib.metadata.version("mutmut"),
-               "max_children": args.max_children, "modules_requested": args.modules or ["(all configured)"],
+               "max_children": args.max_children, "modules_requested": args.modules or modules,
                "tests_left_out": args.without, "tests_at": args.tests_at, "mutmut_exit_code": run.returncode,
                "mutants_measured": len(measured),
                "modules": per_module, "lowest_kill_rate": min(rates) if rates else None, "survivors": survivors,
