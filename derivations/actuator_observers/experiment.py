@@ -17,6 +17,7 @@ import casadi as ca
 import numpy as np
 
 from derivations.actuator_observers.claims import core_paper_claims
+from derivations.actuator_observers.continuous import campaign_results, corrected_docking
 from derivations.actuator_observers.dock import cross_track_rms, dock_miss
 from derivations.actuator_observers.figures import actuation_figure, estimates_figure, path_figure
 from derivations.actuator_observers.observer_sets import actuator_observers
@@ -163,6 +164,7 @@ def build(out_dir: Path, progress) -> None:
     results["remus100"] = _second_case(progress)
     progress("C sources of the observers: write, compile, compare")
     results["c"] = _generated_c(scenario, out_dir / "c")
+    results["continuous"] = {"campaign": campaign_results(out_dir, progress), "docking": corrected_docking(progress)}
     progress("machine-checked claims")
     results["claims"] = claim_rows(core_paper_claims())
     write_json(out_dir / "results.json", _round(results))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 from uvsym.errors import DiagnosisError
 from uvsym.faults import ACTUATOR_KINDS
@@ -71,12 +71,12 @@ class DiagnosisSettings:
 
     def detection_threshold(self, hypotheses: int) -> float:
         """GLR above which a window alarms: chi2(1) quantile at false_alarm_rate / hypotheses."""
-        return float(chi2.isf(self.false_alarm_rate / max(hypotheses, 1), 1))
+        return float(chdtri(1, self.false_alarm_rate / max(hypotheses, 1)))
 
     @property
     def isolation_margin(self) -> float:
         """GLR lead (noise variances) the best hypothesis needs over every rival."""
-        return float(chi2.isf(self.isolation_error_rate, 1))
+        return float(chdtri(1, self.isolation_error_rate))
 
 
 def _positive(name: str, value) -> None:

@@ -310,8 +310,10 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
         raise ScenarioError("diagnosis.observer: the diagnosis reads the bias observer's estimate, and the scenario "
                             "runs none; add [[observers]] with kind = \"bias\"")
     lists = {}
+    rules = {"kinds": "fault kinds: " + ", ".join(ACTUATOR_KINDS),
+             "actuators": "the vehicle's input labels (none: all)"}
     for key, known in (("kinds", ACTUATOR_KINDS), ("actuators", model.input_labels)):
-        value = fields.raw(key, list(getattr(defaults, key)), "list of strings", "one of " + ", ".join(known))
+        value = fields.raw(key, list(getattr(defaults, key)), "list of strings", rules[key])
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
             raise ScenarioError(f"diagnosis.{key}: expected a list of names, got {value!r}")
         for item in value:
@@ -321,8 +323,9 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
                                     if near else "") + f"; known: {', '.join(known)}")
         lists[key] = tuple(value)
     numbers = {key: fields.number(key, getattr(defaults, key), positive=True)
-               for key in ("window_s", "min_window_s", "period_s", "false_alarm_rate", "isolation_error_rate",
-                           "resolution", "floor")}
+               for key in ("window_s", "min_window_s", "period_s", "resolution", "floor")}
+    for key in ("false_alarm_rate", "isolation_error_rate"):  # probabilities, checked by DiagnosisSettings
+        numbers[key] = fields.raw(key, getattr(defaults, key), "number", "in (0, 1), per test")
     confirm = fields.raw("confirm", defaults.confirm, "integer", ">= 1 (decisions)")
     correct = fields.raw("correct", defaults.correct, "boolean", "feed identified faults back as a correction")
     noise_fields = fields.table("noise")

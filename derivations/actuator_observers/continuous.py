@@ -1,0 +1,126 @@
+"""uvsym's continuous diagnosis in the study: the fault campaign and the corrected docking run.
+
+Runs ``campaign.toml`` through :func:`uvsym.campaign.run_campaign` (the same file ``uvsym
+campaign`` runs) and the shipped ``docking_diagnosis`` scenario (diagnosis and correction in the
+loop); returns their figures for results.json and writes the campaign's table and figures.
+"""
+
+from __future__ import annotations
+
+import csv
+import tempfile
+from collections import Counter
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, targets
+from derivations.actuator_observers.dock import cross_track_rms, dock_miss
+from uvsym.campaign import load_campaign, run_campaign
+from uvsym.report import save_svg
+from uvsym.sim.scenario import load_scenario
+from uvsym.sim.simulation import simulate_scenario
+
+__all__ = ["campaign_results", "corrected_docking", "TABLE_COLUMNS"]
+
+# the columns of campaign_results.csv (the run's wall time is left out: the file stays the same)
+TABLE_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "identifiable", "excited",
+                 "detected", "detection_delay_s", "isolated_actuator", "isolated_kind", "isolation_delay_s",
+                 "identified_value", "size_error_rel", "false_alarms", "ambiguous", "status", "error")
+
+
+def _vehicle(case: str) -> str:
+    return case.split(",")[0]
+
+
+def _decided(row: dict) -> str:
+    if row["isolated_actuator"] is None:
+        return "ambiguous" if row["ambiguous"] else "none"
+    return f"{row['isolated_kind']} {row['isolated_actuator']}"
+
+
+def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dict:
+    """Run the campaign; write campaign_results.csv and its figures into out_dir; return its figures."""
+    campaign = load_campaign(CAMPAIGN)
+    progress(f"fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
+    with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+    figures = counts(rows)
+    faulty = [r for r in rows if r["status"] == "ok" and r["true_actuator"] is not None]
+    counted = [r for r in faulty if r["identifiable"] and r["excited"]]
+    confusion = Counter((f"{r['true_kind']} {r['true_actuator']}", _decided(r)) for r in counted)
+    wrong = [{key: r[key] for key in ("case", "true_actuator", "true_kind", "true_value", "onset_s",
+                                      "isolated_actuator", "isolated_kind", "identified_value", "size_error_rel")}
+             for r in counted if not correct(r)]
+    excluded = Counter((_vehicle(r["case"]), r["true_actuator"], r["true_kind"]) for r in faulty
+                       if not (r["identifiable"] and r["excited"]))
+    by_kind = {}
+    for kind in sorted({r["true_kind"] for r in counted}):
+        errors = [r["size_error_rel"] for r in counted if r["true_kind"] == kind and r["size_error_rel"] is not None]
+        by_kind[kind] = {"runs": sum(r["true_kind"] == kind for r in counted),
+                         "correct": sum(correct(r) for r in counted if r["true_kind"] == kind),
+                         "median_size_error_rel": float(np.median(errors)) if errors else None,
+                         "max_size_error_rel": float(np.max(errors)) if errors else None}
+    _write_table(rows, out_dir / "campaign_results.csv")
+    _confusion_figure(confusion, out_dir / "campaign_confusion.svg")
+    _delay_figure(counted, out_dir / "campaign_delays.svg")
+    return {**figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
+            "excluded": [{"vehicle": v, "actuator": a, "kind": k, "runs": n}
+                         for (v, a, k), n in sorted(excluded.items())],
+            "confusion": [{"true": t, "decided": d, "runs": n} for (t, d), n in sorted(confusion.items())]}
+
+
+def corrected_docking(progress) -> dict:
+    """The shipped docking_diagnosis scenario: the continuous diagnosis corrects the docking run."""
+    scenario = load_scenario("docking_diagnosis")
+    progress(f"docking with the continuous diagnosis in the loop ({scenario.name})")
+    result = simulate_scenario(scenario)
+    identified = {e["actuator"]: {"kind": e["kind"], "value": e["value"], "time_s": e["t"]}
+                  for e in result.events if e["event"] == "identified"}
+    isolated = [e["t"] for e in result.events if e["event"] == "isolated"]
+    return {"scenario": scenario.name, "events": result.events, "identified": identified,
+            "isolation_time_s": max(isolated) if isolated else None,
+            "cross_track_rms_m": cross_track_rms(result, scenario), "dock_miss_m": dock_miss(result, scenario)}
+
+
+def _write_table(rows: list[dict], path: Path) -> None:
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(TABLE_COLUMNS)
+        for row in rows:
+            writer.writerow(["" if row.get(c) is None else f"{row[c]:.6g}" if isinstance(row.get(c), float)
+                             else row.get(c) for c in TABLE_COLUMNS])
+
+
+def _confusion_figure(confusion: Counter, path: Path) -> None:
+    """Heat map: true (kind, actuator) against the decision standing at the end, counted runs."""
+    truths = sorted({t for t, _ in confusion})
+    decisions = sorted({d for _, d in confusion} | set(truths))
+    grid = np.zeros((len(truths), len(decisions)))
+    for (t, d), n in confusion.items():
+        grid[truths.index(t), decisions.index(d)] = n
+    fig, ax = plt.subplots(figsize=(1.0 + 0.42 * len(decisions), 1.2 + 0.32 * len(truths)))
+    ax.imshow(grid, cmap="Blues", aspect="auto")
+    for i, j in zip(*np.nonzero(grid)):
+        ax.text(j, i, f"{int(grid[i, j])}", ha="center", va="center", fontsize=7)
+    ax.set_xticks(range(len(decisions)), decisions, rotation=60, ha="right", fontsize=7)
+    ax.set_yticks(range(len(truths)), truths, fontsize=7)
+    ax.set_xlabel("decided (standing at the end of the run)")
+    ax.set_ylabel("injected fault")
+    ax.set_title("Campaign: identifiable, excited runs", fontsize=9)
+    save_svg(fig, path)
+
+
+def _delay_figure(counted: list[dict], path: Path) -> None:
+    """Histograms of detection and isolation delays (s after onset) over the counted runs."""
+    fig, ax = plt.subplots(figsize=(6, 3.2))
+    for key, label in (("detection_delay_s", "detection"), ("isolation_delay_s", "isolation")):
+        values = [r[key] for r in counted if r[key] is not None]
+        if values:
+            ax.hist(values, bins=np.arange(0.0, max(values) + 0.5, 0.25), alpha=0.6, label=f"{label} ({len(values)})")
+    ax.axvline(5.0, color="k", ls=":", lw=1, label="median target 5 s")
+    ax.set_xlabel("delay after onset (s)")
+    ax.set_ylabel("runs")
+    ax.legend(fontsize=8)
+    save_svg(fig, path)
