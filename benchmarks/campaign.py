@@ -3,7 +3,8 @@
 Run ``python benchmarks/campaign.py [--repeat 3]``; writes ``benchmarks/results/campaign.json``.
 The docking closed loop (plant, controller, two observers; 100 s at 100 Hz) is timed the same way
 for every contender: its compiled step rolled over batches of steps that take about 1 ms each,
-repeated, reporting the min time per batch (the headline: the least disturbed by the other users
+the contenders taking turns batch by batch (so that the machine's other users slow them alike),
+reporting the min time per batch (the headline: the least disturbed by the other users
 of a shared machine) and the median, as simulated seconds per wall second.
 
 - scalar: the roll :func:`simulate` uses (``compile_roll``, fast-path flags), and the same loop
@@ -65,30 +66,48 @@ def docking_runs(count: int):
     return scenarios
 
 
-def timed_batches(roll, z, W, out, steps: int) -> np.ndarray:
-    """Wall seconds of successive rolls of ``steps`` samples (the trajectory continues; restarts at its end)."""
-    times, start, z0 = np.empty(BATCHES), 0, z
-    for b in range(BATCHES):
-        if start + steps > W.shape[0] - 1:
-            start, z = 0, z0
+class Contender:
+    """A compiled roll over one or several trajectories, timed over batches of ``steps`` samples that continue
+    the trajectories (from z0 again at the end of W)."""
+
+    def __init__(self, roll, z0: np.ndarray, W: np.ndarray, n_out: int, trajectories: int):
+        self.roll, self.z0, self.W, self.trajectories = roll, z0, W, trajectories
+        self.out = np.empty((W.shape[0], n_out, *W.shape[2:]))
+        self.z, self.start, self.steps, self.times = z0, 0, 200, []
+
+    def batch(self) -> float:
+        """Wall seconds of one batch."""
+        if self.start + self.steps > self.W.shape[0] - 1:
+            self.start, self.z = 0, self.z0
         begun = time.perf_counter()
-        z = roll(z, W[start:start + steps], out[:steps])
-        times[b] = time.perf_counter() - begun
-        start += steps
-    return times
+        self.z = self.roll(self.z, self.W[self.start:self.start + self.steps], self.out[:self.steps])
+        elapsed = time.perf_counter() - begun
+        self.start += self.steps
+        return elapsed
+
+    def calibrate(self) -> None:
+        """Steps per batch for batches of about BATCH_S, from the median of a few probes."""
+        probes = [self.batch() for _ in range(10)]
+        self.steps = int(min(max(self.steps * BATCH_S / np.median(probes[5:]), 10), self.W.shape[0] - 1))
+
+    def summary(self, dt: float) -> dict:
+        """min (best) and median trajectory-seconds per wall second over the timed batches."""
+        times, simulated = np.array(self.times), self.trajectories * self.steps * dt
+        return {"steps_per_batch": self.steps, "batches": len(times), "batch_s_min": float(times.min()),
+                "batch_s_median": float(np.median(times)), "best": simulated / float(times.min()),
+                "median": simulated / float(np.median(times)),
+                "ns_per_trajectory_step_median": 1e9 * float(np.median(times)) / (self.steps * self.trajectories)}
 
 
-def rates(roll, z, W, out, trajectories: int, dt: float) -> dict:
-    """min and median trajectory-seconds per wall second over ~1 ms batches (steps per batch calibrated)."""
-    probe = 200
-    timed_batches(roll, z, W, out, probe)  # warm the caches and pages
-    per_step = np.median(timed_batches(roll, z, W, out, probe)) / probe
-    steps = int(min(max(BATCH_S / per_step, 10), W.shape[0] - 1))
-    times = timed_batches(roll, z, W, out, steps)
-    simulated = trajectories * steps * dt
-    return {"steps_per_batch": steps, "batch_s_min": float(times.min()), "batch_s_median": float(np.median(times)),
-            "best": simulated / float(times.min()), "median": simulated / float(np.median(times)),
-            "ns_per_trajectory_step_median": 1e9 * float(np.median(times)) / (steps * trajectories)}
+def interleaved(contenders: dict[str, Contender], dt: float) -> dict[str, dict]:
+    """Every contender timed over BATCHES batches, taking turns batch by batch, so that the other users of
+    the machine slow them alike."""
+    for contender in contenders.values():
+        contender.calibrate()
+    for _ in range(BATCHES):
+        for contender in contenders.values():
+            contender.times.append(contender.batch())
+    return {name: contender.summary(dt) for name, contender in contenders.items()}
 
 
 def measure(lanes: int) -> dict:
@@ -100,19 +119,20 @@ def measure(lanes: int) -> dict:
     observers = observer_blocks(first.model, first.observers, dt)
 
     scalar = prepare_run(first.model, first.controller, **scenario_arguments(first, observers))
-    out = np.empty((scalar.W.shape[0], scalar.loop.step.nnz_out(1)))
-    scalar_fast = rates(compile_roll(scalar.loop.step), scalar.z0, scalar.W, out, 1, dt)
-    scalar_default = rates(compile_roll(scalar.loop.step, DEFAULT_FLAGS), scalar.z0, scalar.W, out, 1, dt)
-
     loop = build_closed_loop(first.model, first.controller, dt, observers=observers)
     batch = [prepare_run(s.model, s.controller, **scenario_arguments(s, observers), loop=loop) for s in scenarios]
-    by_lanes = {}
+    n_out = loop.step.nnz_out(1)
+    contenders = {"scalar_fast_flags": Contender(compile_roll(scalar.loop.step), scalar.z0, scalar.W, n_out, 1),
+                  "scalar_default_flags": Contender(compile_roll(scalar.loop.step, DEFAULT_FLAGS), scalar.z0,
+                                                    scalar.W, n_out, 1)}
     for count in (lanes, *OTHER_LANES):
-        W = np.ascontiguousarray(np.stack([run.W for run in batch[:count]], axis=-1))
-        z0 = np.ascontiguousarray(np.stack([run.z0 for run in batch[:count]], axis=-1))
-        out_lanes = np.empty((W.shape[0], loop.step.nnz_out(1), count))
-        by_lanes[count] = rates(compile_lanes(loop.step, count), z0, W, out_lanes, count, dt)
-    batched = by_lanes[lanes]
+        contenders[f"lanes_{count}"] = Contender(
+            compile_lanes(loop.step, count), np.ascontiguousarray(np.stack([run.z0 for run in batch[:count]], axis=-1)),
+            np.ascontiguousarray(np.stack([run.W for run in batch[:count]], axis=-1)), n_out, count)
+    timed = interleaved(contenders, dt)
+    scalar_fast, scalar_default, batched = timed["scalar_fast_flags"], timed["scalar_default_flags"], \
+        timed[f"lanes_{lanes}"]
+    by_lanes = {count: timed[f"lanes_{count}"] for count in (lanes, *OTHER_LANES)}
     scenarios = scenarios[:lanes]
 
     simulate_scenario(first)  # the first run compiles (or finds the library in the cache)
@@ -127,7 +147,8 @@ def measure(lanes: int) -> dict:
     simulate_batch(scenarios, lanes=lanes)
     batch_wall = time.perf_counter() - begun
     return {"load_average_before": load, "scalar_fast_flags": scalar_fast, "scalar_default_flags": scalar_default,
-            "batched": batched, "batched_median_by_lanes": {str(k): v["median"] for k, v in by_lanes.items()},
+            "batched": batched,
+            "batched_by_lanes": {str(k): {"best": v["best"], "median": v["median"]} for k, v in by_lanes.items()},
             "warm_start_s": {"min": min(warm), "median": float(np.median(warm))},
             "simulate_batch_end_to_end_s": batch_wall,
             "simulate_batch_end_to_end_traj_sim_s_per_wall_s": lanes * DURATION / batch_wall,
