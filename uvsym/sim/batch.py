@@ -112,13 +112,13 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool
             clean = bool(np.isfinite(outputs[start:start + k]).all() and np.isfinite(z).all())
             for lane in range(real):
                 W_rows, rows, guard = W[start:start + k, :, lane], outputs[start:start + k, :, lane], group[lane].guard
-                if clean and guard is not None:
-                    guard(W_rows[:, 0], rows)
-                elif not clean:
-                    try:
+                try:
+                    if not clean:
                         check_chunk(loop, "fast", start, W_rows, rows, z[:, lane], guard)
-                    except SimulationError as exc:
-                        raise SimulationError(f"run {names[first + lane]}: {exc}") from None
+                    elif guard is not None:
+                        guard(W_rows[:, 0], rows)
+                except SimulationError as exc:
+                    raise SimulationError(f"run {names[first + lane]}: {exc}") from None
         for lane in range(real):
             outputs[N, :, lane] = np.asarray(loop.discrete(z[:, lane], W[N, :, lane])[2]).ravel()
         by_lane = np.ascontiguousarray(outputs.transpose(2, 0, 1)[:real])  # (lane, sample, out): one pass
