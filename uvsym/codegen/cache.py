@@ -1,8 +1,9 @@
 """Compiled libraries kept between runs, named by the SHA-256 of everything that determines them.
 
 The key hashes the serialised CasADi Function, the extra C source compiled with it, the compiler
-flags, the compiler's identity (first line of ``cc --version``) and the CasADi version, so a
-library is reused only when it would be compiled again byte for byte. The folder is
+flags, the compiler's identity (first line of ``cc --version``), the processor (``-march=native``
+builds for it: a cache folder shared between machines keeps one library per processor) and the
+CasADi version, so a library is reused only when it would be compiled again byte for byte. The folder is
 ``$UVSYM_CACHE_DIR``, else ``$XDG_CACHE_HOME/uvsym``, else ``~/.cache/uvsym``; deleting it (or any
 file in it) is always safe. A library is compiled under a temporary name and moved into place with
 ``os.replace``, so two processes compiling the same key at once both end with a whole library.
@@ -15,6 +16,7 @@ import functools
 import hashlib
 import itertools
 import os
+import platform
 import subprocess
 import warnings
 from pathlib import Path
@@ -44,10 +46,23 @@ def _compiler_identity(compiler: str) -> str:
     return (done.stdout.strip().splitlines() or [""])[0]
 
 
+@functools.lru_cache(maxsize=None)
+def _processor() -> str:
+    """The processor's model and feature flags (Linux's /proc/cpuinfo), else what platform knows of it."""
+    try:
+        with open("/proc/cpuinfo") as handle:
+            lines = [line for line in handle if line.startswith(("model name", "flags", "Features", "CPU part"))]
+        if lines:
+            return "".join(dict.fromkeys(lines))
+    except OSError:
+        pass
+    return f"{platform.machine()} {platform.processor()} {platform.platform()}"
+
+
 def library_key(f: ca.Function, extra_source: str, flags: tuple[str, ...], compiler: str) -> str:
-    """Hex SHA-256 of ``f.serialize()``, ``extra_source``, ``flags``, the compiler and CasADi version."""
+    """Hex SHA-256 of ``f.serialize()``, ``extra_source``, ``flags``, the compiler, processor and CasADi version."""
     digest = hashlib.sha256()
-    for part in (f.serialize(), extra_source, "\0".join(flags), compiler, _compiler_identity(compiler),
+    for part in (f.serialize(), extra_source, "\0".join(flags), compiler, _compiler_identity(compiler), _processor(),
                  ca.__version__):
         digest.update(part.encode() if isinstance(part, str) else bytes(part))
         digest.update(b"\0\1\0")
