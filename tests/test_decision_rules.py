@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from uvsym.errors import ObserverError
 from uvsym.models.registry import vehicle
 from uvsym.observers.ftc import Correction
 from uvsym.observers.isolation import ChannelDecision, IsolationResult, IsolationSettings, Isolator
@@ -205,3 +206,11 @@ def test_a_correction_acts_from_the_first_sample_after_the_checked_chunk():
     assert np.count_nonzero(~on) == 30
     np.testing.assert_array_equal(added[~on], 0.0)
     np.testing.assert_allclose(added[on], np.tile([5.0, 0.0, 0.0, 0.0], (np.count_nonzero(on), 1)), atol=1e-12)
+
+
+def test_an_isolator_needs_an_observer_and_reports_its_faulty_channels_apart():
+    with pytest.raises(ObserverError, match="isolation needs at least one observer"):
+        Isolator({}, ("X",))
+    decisions = {"X": ChannelDecision("X", "bias", 1.0, 2.0, V), "Y": ChannelDecision("Y", "healthy", 1.5, 0.0, V)}
+    result = IsolationResult(T, ("X", "Y"), {}, {}, decisions)
+    assert result.faulty == {"X": decisions["X"]}
