@@ -73,6 +73,8 @@ def test_a_solver_P_is_proved_with_the_smallest_pivot_as_margin(solver_answer):
     assert certificate.margin == 2.0 and certificate.details["P"] == [[2.0, 0.0], [0.0, 2.0]]
     # gamma = 3/4: Q = (2 - 2 gamma) P = I, now the tighter
     assert lyapunov_decrease("V decreases", [MINUS_I], 0.75, "one matrix").margin == 1.0
+    solver_answer(2 * np.eye(2), "optimal_inaccurate")  # an inaccurate answer is re-checked like any other
+    assert lyapunov_decrease("V decreases", [MINUS_I], 0.75, "one matrix").margin == 1.0
 
 
 def test_the_exact_check_uses_twice_gamma(solver_answer):
@@ -150,7 +152,7 @@ def test_a_discrete_map_at_the_rate_is_refuted_with_its_eigenvalue():
 
 def _timed(certificate):
     """The certificate with its run time zeroed, after checking that one was measured."""
-    assert isinstance(certificate.seconds, float) and certificate.seconds > 0
+    assert isinstance(certificate.seconds, float) and 0 < certificate.seconds < 60
     return replace(certificate, seconds=0.0)
 
 
