@@ -80,3 +80,13 @@ def test_a_batch_refuses_a_supervisor_and_what_is_not_a_scenario(scenarios):
         simulate_batch(scenarios, supervisor=object())
     with pytest.raises(SimulationError, match=r"scenarios\[1\] must be a Scenario, got dict"):
         simulate_batch([scenarios[0], {}])
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+def test_a_diverging_lane_is_reported_as_its_scalar_run_is_naming_it(scenarios):
+    wild = replace(scenarios[0], name="wild_current", current=(1e200, 0.3))  # drag overflows in the first step
+    with pytest.raises(SimulationError) as scalar:
+        simulate_scenario(wild)
+    with pytest.raises(SimulationError) as lanes:
+        simulate_batch([scenarios[0], wild], lanes=4)
+    assert "diverged: x." in str(scalar.value) and str(lanes.value) == f"run wild_current: {scalar.value}"

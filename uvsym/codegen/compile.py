@@ -221,7 +221,7 @@ def _generated(step: ca.Function) -> str:
 
 def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_FLAGS):
     """``step(z, w) -> (z_next, out)`` run for ``lanes`` trajectories at once, in a C loop over lanes that
-    gcc vectorises (glibc's vector math for sin, cos, exp, log, pow).
+    gcc vectorises (through glibc's vector math library, libmvec, for sin, cos, atan2, exp, ...).
 
     Returns ``roll(z0 (n_z, L), W (k, n_w, L), out (k, n_out, L)) -> z_end (n_z, L)``: k steps of every
     lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays).
