@@ -65,7 +65,7 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     joined by "|";
     isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
     identified_value: the last "identified" value in the window for it (or naming none);
-    size_error_rel: |identified - true| / |true| (None when true is 0); false_alarms: alarms
+    size_error_rel: ``abs(identified - true) / abs(true)`` (None when true is 0); false_alarms: alarms
     outside the window (module docstring); ambiguous, unexcited: any such event; events: how many.
     """
     events = sorted(events, key=lambda e: e["t"])

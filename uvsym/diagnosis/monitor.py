@@ -42,6 +42,8 @@ from uvsym.observers.identification import ActuatorFaultEstimate, configuration_
 
 __all__ = ["ActuatorDiagnosis", "residual_noise"]
 
+_REVISE_EVERY = 5  # decisions between re-judgements of the decided faults' kinds
+
 
 @dataclass
 class _Decided:
@@ -52,6 +54,7 @@ class _Decided:
     isolated_s: float
     identified: bool = False
     clear_streak: int = 0
+    revise_streak: int = 0
 
 
 def residual_noise(model: Model, observer: ActuatorObserver, K, dt: float, settings: DiagnosisSettings,
@@ -182,6 +185,8 @@ class ActuatorDiagnosis:
         fit = self._fit(rows, candidates)
         explained = not candidates or np.nanmax(fit.glr) <= self.h_detect
         self._update_model(k, rows, fit, explained)
+        if (k // self.every) % _REVISE_EVERY == 0:
+            self._revise(k, rows, fit.J_model)
         self._watch_excitation(k, candidates, fit)
         glr = np.nan_to_num(fit.glr, nan=-np.inf)
         if candidates and np.max(glr) > self.h_detect:
@@ -216,6 +221,32 @@ class ActuatorDiagnosis:
             if decided.clear_streak >= self.settings.confirm:
                 del self.decided[a]
                 self._log(k, "cleared", self.labels[a], decided.hypothesis.kind.name)
+
+    def _revise(self, k: int, rows: np.ndarray, J_model: float) -> None:
+        """Re-judge each decided fault's kind on a window wholly after its onset: a rival kind on the same
+        actuator that fits better by the isolation margin (both through the exact force model) in
+        ``confirm`` checks running replaces it -- e.g. a bias first seen while the command sat on its
+        limit, where it acts like an actuator stuck there."""
+        for a, decided in list(self.decided.items()):
+            h = decided.hypothesis
+            if rows[0] < h.onset or len(self.kinds) < 2:
+                continue
+            others = [replace(d.hypothesis, at=d.value) for b, d in self.decided.items() if b != a]
+            values = np.array([d.value for b, d in self.decided.items() if b != a])
+            rivals = [Hypothesis(a, kind, h.onset) for kind in self.kinds if kind.name != h.kind.name]
+            linear = fit_window(self.bank, rows, others, values, rivals, self._transient(len(rows)))
+            if not np.any(np.isfinite(linear.theta)):
+                continue
+            best = int(np.nanargmax(np.where(np.isfinite(linear.theta), linear.glr, -np.inf)))
+            rival = replace(rivals[best], at=float(linear.theta[best]))
+            exact = fit_window(self.bank, rows, others + [rival], np.append(values, rival.at), [],
+                               self._transient(len(rows)))
+            better = exact.J_model + self.h_iso < J_model and np.isfinite(exact.theta_model[-1])
+            decided.revise_streak = decided.revise_streak + 1 if better else 0
+            if decided.revise_streak >= self.settings.confirm:
+                value = float(exact.theta_model[-1])
+                self.decided[a] = _Decided(replace(rival, at=None), value, float(self._t[k]))
+                self._log(k, "isolated", self.labels[a], rival.kind.name, value)
 
     def _watch_excitation(self, k: int, candidates: list[Hypothesis], fit) -> None:
         """Log an actuator as unexcited when a fault of ``resolution`` that scales its command would stay unseen."""
