@@ -7,7 +7,9 @@ a time through :func:`uvsym.codegen.compile_lanes`: one C loop over the steps wh
 lane side by side, vectorised by the compiler. Each run's result equals :func:`simulate_scenario`'s
 for it up to rounding (the vector math library's sin, cos, ... differ from the scalar ones in the
 last bits; tests/test_batch.py). A run needing a supervisor (Python logic between chunks) cannot
-run in lanes: :func:`simulate_batch` refuses one, :func:`simulate_scenario` runs it.
+run in lanes: :func:`simulate_batch` refuses one, and a scenario whose [diagnosis] corrects the
+commands, while it runs a diagnosis that only watches on the finished record, as
+:func:`simulate_scenario` does; :func:`simulate_scenario` runs the others.
 Without a C compiler, or for a step the lanes cannot run, every run falls back to the scalar path
 (with a warning).
 """
@@ -45,8 +47,8 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
     Raises
     ------
     SimulationError
-        For a supervisor (lanes run without Python in the loop), and as :func:`simulate_scenario` does
-        for a run that diverges (naming the scenario).
+        For a supervisor or a [diagnosis] that corrects the commands (lanes run without Python in the
+        loop), and as :func:`simulate_scenario` does for a run that diverges (naming the scenario).
     """
     if supervisor is not None:
         raise SimulationError("simulate_batch runs without a supervisor (no Python between the steps of the lanes); "
@@ -55,6 +57,9 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
     for i, scenario in enumerate(scenarios):
         if not isinstance(scenario, Scenario):
             raise SimulationError(f"scenarios[{i}] must be a Scenario, got {type(scenario).__name__}")
+        if scenario.diagnosis is not None and scenario.diagnosis.correct:
+            raise SimulationError(f"scenarios[{i}] ({scenario.name}): its [diagnosis] corrects the commands, a "
+                                  "supervisor the lanes cannot run; run it with simulate_scenario")
         shape = (id(scenario.model), id(scenario.controller), scenario.observers, scenario.sensor_faults,
                  scenario.step, scenario.duration)
         groups.setdefault(shape, []).append(i)
@@ -68,8 +73,21 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
                             substeps=substeps, loop=loop) for i in members]
         names = [scenarios[i].name for i in members]
         for i, result in zip(members, run_lanes(runs, lanes=lanes, compiled=compiled, names=names)):
-            results[i] = SimResult(result.t, result.signals, {"scenario": scenarios[i].name, **result.meta})
+            meta = {"scenario": scenarios[i].name, **result.meta}
+            if scenarios[i].diagnosis is not None:
+                meta["events"] = _diagnosed(scenarios[i], result)
+            results[i] = SimResult(result.t, result.signals, meta)
     return results
+
+
+def _diagnosed(scenario: Scenario, result: SimResult) -> list[dict]:
+    """The decision log of the scenario's [diagnosis] run on the finished record, as :func:`simulate_scenario`
+    gives it for a diagnosis that does not correct."""
+    from uvsym.diagnosis.run import diagnosis_for  # the diagnosis package builds on uvsym.sim
+
+    diagnosis = diagnosis_for(scenario)
+    diagnosis.update(result.t, {name: result[name].values for name in diagnosis.reads})
+    return [event.as_dict() for event in diagnosis.events]
 
 
 def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool = True,
