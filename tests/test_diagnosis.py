@@ -48,12 +48,10 @@ def test_residual_model_matches_the_simulated_observer():
     diagnosis.update(result.t, {name: result[name].values for name in diagnosis.reads})
     bank = diagnosis.bank
     rows = np.arange(len(result.t))
-    fit = fit_window(bank, rows, [Hypothesis(0, actuator_kind("bias"), onset=500, at=10.0)], np.array([10.0]), [],
-                     bank.transient(len(rows)))
+    fit = fit_window(bank, rows, [Hypothesis(0, actuator_kind("bias"), onset=500, at=10.0)], np.array([10.0]), [])
     assert fit.theta_model[0] == pytest.approx(10.0, rel=1e-3)
     # the same fault placed one second late explains the record far worse
-    late = fit_window(bank, rows, [Hypothesis(0, actuator_kind("bias"), onset=600, at=10.0)], np.array([10.0]), [],
-                      bank.transient(len(rows)))
+    late = fit_window(bank, rows, [Hypothesis(0, actuator_kind("bias"), onset=600, at=10.0)], np.array([10.0]), [])
     assert late.J_model > 100 * max(fit.J_model, 1.0)
 
 
@@ -72,7 +70,7 @@ def test_noise_level_is_not_underestimated():
     glr = []
     for end in range(W, len(result.t), W):  # disjoint windows
         rows = np.arange(end - W, end)
-        glr.append(fit_window(bank, rows, [], np.zeros(0), hypotheses, bank.transient(W)).glr)
+        glr.append(fit_window(bank, rows, [], np.zeros(0), hypotheses).glr)
     assert 0.0 < np.median(glr) < 0.45
     assert np.max(glr) < diagnosis.h_detect / 2
     # the same noise left out of the noise level: the statistic explodes, so the check can fail
@@ -80,7 +78,7 @@ def test_noise_level_is_not_underestimated():
     naive = diagnosis_for(quiet)
     naive.update(result.t, {name: result[name].values for name in naive.reads})
     rows = np.arange(W, 2 * W)
-    assert np.mean(fit_window(naive.bank, rows, [], np.zeros(0), hypotheses, naive.bank.transient(W)).glr) > 10
+    assert np.mean(fit_window(naive.bank, rows, [], np.zeros(0), hypotheses).glr) > 10
 
 
 @pytest.mark.parametrize("actuator, kind, value", [("X", "constant", 20.0), ("delta_ru", "bias", 0.05),

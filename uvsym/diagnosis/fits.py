@@ -55,9 +55,10 @@ class WindowFit:
 class _Columns:
     """The window's column matrix Z = [free response | residual | F[B_a], F[B_a v] per (a, onset)]."""
 
-    def __init__(self, bank: RegressorBank, rows: np.ndarray, transient: np.ndarray, hypotheses: list[Hypothesis]):
-        self.n_t = transient.shape[1]
-        blocks = [transient, (bank.r[rows] / bank.sigma).reshape(-1, 1)]
+    def __init__(self, bank: RegressorBank, rows: np.ndarray, hypotheses: list[Hypothesis]):
+        self.n_t = bank.n
+        sigma = bank.sigma[rows]
+        blocks = [bank.transient(rows), (bank.r[rows] / sigma).reshape(-1, 1)]
         self.index: dict[tuple, int] = {}
         for h in hypotheses:
             key = self._key(h, rows[0])
@@ -68,7 +69,7 @@ class _Columns:
                             bank.gated(bank.H[:, h.actuator], rows, h.onset))
                 else:
                     pair = bank.exact(rows, h.actuator, h.kind, h.at, h.onset)
-                blocks += [(column / bank.sigma).reshape(-1, 1) for column in pair]
+                blocks += [(column / sigma).reshape(-1, 1) for column in pair]
         self.rows0 = rows[0]
         Z = np.hstack(blocks)
         self.S = Z.T @ Z
@@ -104,13 +105,12 @@ def _schur(S: np.ndarray, basis: np.ndarray, W: np.ndarray) -> np.ndarray:
 
 
 def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], values: np.ndarray,
-               candidates: list[Hypothesis], transient: np.ndarray) -> WindowFit:
+               candidates: list[Hypothesis]) -> WindowFit:
     """Fit the model's faults on ``rows`` and test each candidate added to them.
 
-    values: (len(model),) the model faults' decided sizes (for ``power``); transient: the
-    whitened free-response columns for ``len(rows)`` (:meth:`RegressorBank.transient`).
+    values: (len(model),) the model faults' decided sizes (for ``power``).
     """
-    Z = _Columns(bank, rows, transient, model + candidates)
+    Z = _Columns(bank, rows, model + candidates)
     free = np.eye(Z.size)[:, :Z.n_t]
     model_cols = [Z.hypothesis(h) for h in model]
     y = Z.unit(Z.n_t) - sum((c for c, _ in model_cols), np.zeros(Z.size))

@@ -31,7 +31,7 @@ import numpy as np
 
 from uvsym.diagnosis.events import Event
 from uvsym.diagnosis.fits import Hypothesis, fit_window
-from uvsym.diagnosis.regressors import RegressorBank
+from uvsym.diagnosis.regressors import RegressorBank, ResidualNoise
 from uvsym.diagnosis.settings import DiagnosisSettings
 from uvsym.errors import DiagnosisError
 from uvsym.faults import actuator_kind
@@ -41,8 +41,6 @@ from uvsym.observers.ftc import Correction, linear_correction
 from uvsym.observers.identification import ActuatorFaultEstimate, configuration_at
 
 __all__ = ["ActuatorDiagnosis", "residual_noise"]
-
-_REVISE_EVERY = 5  # decisions between re-judgements of the decided faults' kinds
 
 
 @dataclass
@@ -58,11 +56,12 @@ class _Decided:
 
 
 def residual_noise(model: Model, observer: ActuatorObserver, K, dt: float, settings: DiagnosisSettings,
-                   y0) -> np.ndarray:
-    """(n,) noise level of the bias observer's estimate per force channel (N, N m).
+                   y0) -> ResidualNoise:
+    """The noise of the bias observer's estimate (:class:`~uvsym.diagnosis.regressors.ResidualNoise`).
 
     Sensor noise on the velocities (``settings.noise``) reaches the estimate through ``L = dR/dnu``
-    (sampled-data gain ``(I - dt/2 P)^-1 L``); noise on positions and attitudes does not. ``floor``
+    (sampled-data gain ``(I - dt/2 P)^-1 L``) -- and, depending on the state, through the observer's
+    force terms (evaluated per sample by the bank); noise on positions and attitudes does not. ``floor``
     times the force the actuators can produce on a channel at the state y0 (each actuator taken
     from 0 to either limit) is added in quadrature; a channel no actuator reaches gets 1e-3 of the
     largest level (it carries no hypothesis, only model error).
@@ -89,23 +88,23 @@ def residual_noise(model: Model, observer: ActuatorObserver, K, dt: float, setti
     L = np.asarray(observer.L(y0[n:], tau0, K))
     P = np.asarray(observer.error_matrix(tau0, K))
     gain = np.linalg.solve(np.eye(n) - dt / 2 * P, L)
-    sigma = np.sqrt((gain**2) @ std**2 + (settings.floor * scale) ** 2)
-    if not np.any(sigma > 0):
+    white = np.sqrt((gain**2) @ std**2 + (settings.floor * scale) ** 2)
+    if not np.any(white > 0):
         raise DiagnosisError(f"diagnosis: no actuator of {model.name} produces any force at the initial state "
                              "and no sensor noise is given; set diagnosis.noise")
-    return np.maximum(sigma, 1e-3 * np.max(sigma))
+    return ResidualNoise(np.maximum(white, 1e-3 * np.max(white)), std)
 
 
 class ActuatorDiagnosis:
     """Supervisor (see :class:`uvsym.sim.Supervisor`) that diagnoses the actuators of ``model``.
 
     observer, K: the bias observer running in the loop under ``settings.observer`` (its estimate
-    arrives as ``f_hat/<name>``); dt: sample period (s); sigma: (n,) noise level of its estimate
+    arrives as ``f_hat/<name>``); dt: sample period (s); noise: the noise of its estimate
     (:func:`residual_noise`). After a run, ``events`` is the decision log and ``faults`` maps each
     actuator in the model to its :class:`ActuatorFaultEstimate`.
     """
 
-    def __init__(self, model: Model, observer: ActuatorObserver, K, dt: float, sigma,
+    def __init__(self, model: Model, observer: ActuatorObserver, K, dt: float, noise: ResidualNoise,
                  settings: DiagnosisSettings | None = None):
         settings = settings or DiagnosisSettings()
         if not actuator_kind(observer.kind).shift[1] or actuator_kind(observer.kind).gain != (1.0, 0.0):
@@ -122,17 +121,17 @@ class ActuatorDiagnosis:
         self.candidates = [labels.index(a) for a in settings.actuators] or list(range(len(labels)))
         self.kinds = [actuator_kind(k) for k in settings.kinds]
         P = np.asarray(observer.error_matrix(np.ones(model.dof), self.K))
-        self.bank = RegressorBank(model, P, dt, np.asarray(sigma, dtype=float))
+        self.bank = RegressorBank(model, P, dt, noise)
         self.every = max(1, int(round(settings.period_s / dt)))
         self.W = max(3, int(round(settings.window_s / dt)))
         self.W_min = max(3, int(round(settings.min_window_s / dt)))
+        self.W_iso = max(self.W, int(round(settings.isolation_window_s / dt)))
         self.h_detect = settings.detection_threshold(len(self.candidates) * len(self.kinds))
         self.h_iso = settings.isolation_margin
         self.name = settings.observer
         self.reads = ("y", "u_expected", f"f_hat/{self.name}")
         self.events: list[Event] = []
         self.decided: dict[int, _Decided] = {}
-        self._transients: dict[int, np.ndarray] = {}
         self._alarms = 0
         self._episode: int | None = None  # first alarming row of the current episode
         self._logged: set[str] = set()  # what this episode has logged already
@@ -165,15 +164,10 @@ class ActuatorDiagnosis:
             return linear_correction(self.faults, self.labels, B)
         return None
 
-    def _transient(self, length: int) -> np.ndarray:
-        if length not in self._transients:
-            self._transients[length] = self.bank.transient(length)
-        return self._transients[length]
-
     def _fit(self, rows: np.ndarray, candidates: list[Hypothesis]):
         model = [replace(d.hypothesis, at=d.value) for d in self.decided.values()]
         values = np.array([d.value for d in self.decided.values()])
-        return fit_window(self.bank, rows, model, values, candidates, self._transient(len(rows)))
+        return fit_window(self.bank, rows, model, values, candidates)
 
     def _log(self, k: int, event: str, actuator: str | None, kind: str | None = None, value=None) -> None:
         self.events.append(Event(float(self._t[k]), event, actuator, kind, None if value is None else float(value)))
@@ -185,7 +179,7 @@ class ActuatorDiagnosis:
         fit = self._fit(rows, candidates)
         explained = not candidates or np.nanmax(fit.glr) <= self.h_detect
         self._update_model(k, rows, fit, explained)
-        if (k // self.every) % _REVISE_EVERY == 0:
+        if (k // self.every) % max(1, self.W // self.every) == 0:  # once a window
             self._revise(k, rows, fit.J_model)
         self._watch_excitation(k, candidates, fit)
         glr = np.nan_to_num(fit.glr, nan=-np.inf)
@@ -213,7 +207,7 @@ class ActuatorDiagnosis:
             if not decided.identified:
                 if not explained:
                     continue
-                decided.identified = True
+                decided.value, decided.identified = self._size(k, a), True
                 self._log(k, "identified", self.labels[a], decided.hypothesis.kind.name, decided.value)
                 continue
             gone = fit.power[i] > self.h_detect and fit.removal[i] < self.h_iso
@@ -222,10 +216,18 @@ class ActuatorDiagnosis:
                 del self.decided[a]
                 self._log(k, "cleared", self.labels[a], decided.hypothesis.kind.name)
 
+    def _size(self, k: int, actuator: int) -> float:
+        """The size of a decided fault fitted on the record since its onset (at most isolation_window_s)."""
+        rows = np.arange(max(self.decided[actuator].hypothesis.onset, k - self.W_iso + 1), k + 1)
+        fit = self._fit(rows, [])
+        value = fit.theta_model[list(self.decided).index(actuator)]
+        return float(value) if np.isfinite(value) else self.decided[actuator].value
+
     def _revise(self, k: int, rows: np.ndarray, J_model: float) -> None:
-        """Re-judge each decided fault's kind on a window wholly after its onset: a rival kind on the same
-        actuator that fits better by the isolation margin (both through the exact force model) in
-        ``confirm`` checks running replaces it -- e.g. a bias first seen while the command sat on its
+        """Re-judge each decided fault's kind, once a window, on a window wholly after its onset: a rival
+        kind on the same actuator that fits better by the isolation margin (both through the exact force
+        model) in ``confirm`` checks running -- windows that do not overlap, so that a fault coming and
+        going does not count -- replaces it -- e.g. a bias first seen while the command sat on its
         limit, where it acts like an actuator stuck there."""
         for a, decided in list(self.decided.items()):
             h = decided.hypothesis
@@ -234,14 +236,15 @@ class ActuatorDiagnosis:
             others = [replace(d.hypothesis, at=d.value) for b, d in self.decided.items() if b != a]
             values = np.array([d.value for b, d in self.decided.items() if b != a])
             rivals = [Hypothesis(a, kind, h.onset) for kind in self.kinds if kind.name != h.kind.name]
-            linear = fit_window(self.bank, rows, others, values, rivals, self._transient(len(rows)))
+            linear = fit_window(self.bank, rows, others, values, rivals)
             if not np.any(np.isfinite(linear.theta)):
                 continue
             best = int(np.nanargmax(np.where(np.isfinite(linear.theta), linear.glr, -np.inf)))
             rival = replace(rivals[best], at=float(linear.theta[best]))
-            exact = fit_window(self.bank, rows, others + [rival], np.append(values, rival.at), [],
-                               self._transient(len(rows)))
-            better = exact.J_model + self.h_iso < J_model and np.isfinite(exact.theta_model[-1])
+            exact = fit_window(self.bank, rows, others + [rival], np.append(values, rival.at), [])
+            # a rival that explains the window only by acting like no fault leaves the fault to clearing
+            better = (exact.J_model + self.h_iso < J_model and np.isfinite(exact.theta_model[-1])
+                      and exact.power[-1] > self.h_detect)
             decided.revise_streak = decided.revise_streak + 1 if better else 0
             if decided.revise_streak >= self.settings.confirm:
                 value = float(exact.theta_model[-1])
@@ -267,7 +270,7 @@ class ActuatorDiagnosis:
 
     def _isolate(self, k: int, candidates: list[Hypothesis]) -> None:
         """One isolation decision on the record since the episode's first alarm (module docstring)."""
-        start = max(self._episode, k - self.W + 1)
+        start = max(self._episode, k - self.W_iso + 1)
         if k - start + 1 < self.W_min:
             return
         rows = np.arange(start, k + 1)
@@ -316,7 +319,7 @@ class ActuatorDiagnosis:
                 seconds = [h for h in candidates if h.actuator in group[i + 1:]]
                 if not seconds:
                     continue
-                fit = fit_window(self.bank, rows, model + [first], values, seconds, self._transient(len(rows)))
+                fit = fit_window(self.bank, rows, model + [first], values, seconds)
                 for j, second in enumerate(seconds):
                     if np.isfinite(fit.glr[j]):
                         pairs.append((fit.J_model - fit.glr[j], ((first, float(fit.theta_model[-1])),

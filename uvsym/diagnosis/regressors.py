@@ -21,30 +21,55 @@ out of every fit, so a window's verdict depends on its own samples only.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import casadi as ca
 import numpy as np
 import scipy.signal
 
 from uvsym.errors import ObserverError
 from uvsym.models.model import Model
 
-__all__ = ["RegressorBank"]
+__all__ = ["RegressorBank", "ResidualNoise"]
 
 _INSIDE = 1e-6  # B is taken this fraction of the actuator's range inside its limits
+SMOOTHING_S = 0.5  # s, time constant of the low-pass the measured state is smoothed with for the regressors
+
+
+@dataclass(frozen=True)
+class ResidualNoise:
+    """white: (n,) per-sample noise level of the residual that does not depend on the state (N, N m):
+    sensor noise through ``(I - dt/2 P)^-1 L`` and the model-error floor; velocity_std: (n,) the
+    velocity sensors' standard deviations (m/s, rad/s), for the part that does (see RegressorBank)."""
+
+    white: np.ndarray
+    velocity_std: np.ndarray
 
 
 class RegressorBank:
     """Filtered per-actuator regressors and the residual over a growing record.
 
     model: the vehicle; P: (n, n) the bias observer's error matrix (constant, real negative
-    eigenvalues); dt: sample period (s); sigma: (n,) noise level of the residual per force
-    channel (N, N m), the whitening of every fit. After :meth:`append`, ``r`` is (N, n),
-    ``G`` and ``H`` are (N, m, n): ``F[B_a]`` and ``F[B_a u_e,a]`` per actuator a.
+    eigenvalues); dt: sample period (s); noise: the residual's noise. The observer's
+    ``q = P (tau_d - h)`` reads the noisy velocities too, so the residual also carries the filtered
+    white noise ``E n`` with ``E = (I - dt/2 P)^-1 dt P d(tau - h)/dnu``, which depends on the state
+    (fin angles of attack, propeller loading); its slow part has the density of white noise of
+    variance ``(E sigma_n)^2 / (1 - phi)^2``. ``sigma`` (N, n) is the resulting noise level per
+    sample and channel, the whitening of every fit. After :meth:`append`, ``r`` is (N, n),
+    ``G`` and ``H`` are (N, m, n): ``F[B_a]`` and ``F[B_a u_e,a]`` per actuator a; ``y`` (N, 2n)
+    the measured state low-passed (time constant SMOOTHING_S) that B and the exact effects read.
     """
 
-    def __init__(self, model: Model, P: np.ndarray, dt: float, sigma: np.ndarray):
+    def __init__(self, model: Model, P: np.ndarray, dt: float, noise: ResidualNoise):
         self.model, self.dt = model, float(dt)
         self.n, self.m = model.dof, model.n_inputs
-        self.sigma = np.asarray(sigma, dtype=float)
+        self.noise = noise
+        self.sigma = np.zeros((0, self.n))
+        n = self.n
+        eta, nu, u = ca.SX.sym("eta", n), ca.SX.sym("nu", n), ca.SX.sym("u", self.m)
+        self._slope = ca.Function("slope", [eta, nu, u], [ca.jacobian(model.tau.raw(eta, nu, u, 0.0, 0.0)
+                                                                      - model.h.raw(eta, nu), nu)])
+        self._E = np.linalg.solve(np.eye(n) - dt / 2 * P, dt * P)  # times d(tau - h)/dnu
         eigenvalues, V = np.linalg.eig(np.asarray(P, dtype=float))
         if np.max(np.abs(eigenvalues.imag)) > 1e-9 * np.max(np.abs(eigenvalues)) or np.any(eigenvalues.real >= 0):
             raise ObserverError(f"diagnosis: the residual observer's error matrix must have real negative "
@@ -54,9 +79,12 @@ class RegressorBank:
         self.phi = (1 + dt * lam / 2) / (1 - dt * lam / 2)  # per mode
         self.gamma = -lam * dt / (1 - dt * lam / 2)
         self.Phi = self.V @ np.diag(self.phi) @ self.V_inv
+        self._powers: dict[int, np.ndarray] = {}
         self._effects: dict[tuple, tuple] = {}  # exact fault effects computed so far (see exact)
         self._tau_maps: dict[int, object] = {}  # the force model mapped over so many samples
         self._state = None  # per mode: filter state (lfilter zi) and the last raw regressor
+        self._smooth = float(np.exp(-dt / SMOOTHING_S))
+        self._y_state = None
         self._last = None
         self.r = np.zeros((0, self.n))
         self.G = np.zeros((0, self.m, self.n))
@@ -77,7 +105,17 @@ class RegressorBank:
             return
         u_in = np.clip(u_e, *self._inside)
         n, m = self.n, self.m
+        # the state the regressors are evaluated at is smoothed: B depends on it slowly, and its
+        # sensor noise would otherwise correlate with the noise of the residual
+        if self._y_state is None:
+            self._y_state = np.asarray(y[0], dtype=float)[None] * self._smooth
+        y, self._y_state = scipy.signal.lfilter([1.0 - self._smooth], [1.0, -self._smooth], np.asarray(y, dtype=float),
+                                                axis=0, zi=self._y_state)
         B = np.asarray(self.model.B.raw.map(k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
+        slope = np.asarray(self._slope.map(k)(y[:, :n].T, y[:, n:].T, u_e.T)).reshape(n, k, n).transpose(1, 0, 2)
+        E = self._E @ slope  # (k, n, n)
+        slow = (E**2 @ self.noise.velocity_std**2) / np.maximum(1.0 - np.abs(np.diag(self.Phi)), 1e-12) ** 2
+        self.sigma = np.concatenate([self.sigma, np.sqrt(self.noise.white**2 + slow)])
         B = B.reshape(n, k, m).transpose(1, 2, 0)  # (k, m, n): column a of B per sample
         raw = np.concatenate([B, B * u_e[:, :, None]], axis=1)  # (k, 2m, n)
         previous = raw[:1] if self._last is None else self._last[None]
@@ -151,13 +189,16 @@ class RegressorBank:
             out[:, j] = scipy.signal.lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[:, j])
         return out @ self.V.T
 
-    def transient(self, length: int) -> np.ndarray:
-        """(length n, n) whitened free response ``Phi^j e_i`` of the filter over a window."""
-        powers = np.empty((length, self.n, self.n))
-        powers[0] = np.eye(self.n)
-        for j in range(1, length):
-            powers[j] = self.Phi @ powers[j - 1]
-        return (powers / self.sigma[None, :, None]).reshape(length * self.n, self.n)
+    def transient(self, rows: np.ndarray) -> np.ndarray:
+        """(len(rows) n, n) whitened free response ``Phi^j e_i`` of the filter over the window ``rows``."""
+        length = len(rows)
+        if length not in self._powers:
+            powers = np.empty((length, self.n, self.n))
+            powers[0] = np.eye(self.n)
+            for j in range(1, length):
+                powers[j] = self.Phi @ powers[j - 1]
+            self._powers = {length: powers}  # windows of one length follow each other
+        return (self._powers[length] / self.sigma[rows][:, :, None]).reshape(length * self.n, self.n)
 
     def gated(self, series: np.ndarray, rows: np.ndarray, onset: int) -> np.ndarray:
         """``series`` (N, n) on the contiguous ``rows`` as if its input started at sample ``onset``: zero

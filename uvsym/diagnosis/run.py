@@ -20,5 +20,5 @@ def diagnosis_for(scenario: Scenario) -> ActuatorDiagnosis:
         raise DiagnosisError(f"scenario {scenario.name!r} has no [diagnosis] table")
     observer, K = scenario_observers(scenario.model, scenario.observers)[settings.observer]
     y0 = np.concatenate([scenario.eta0, scenario.nu0])
-    sigma = residual_noise(scenario.model, observer, K, scenario.step, settings, y0)
-    return ActuatorDiagnosis(scenario.model, observer, K, scenario.step, sigma, settings)
+    noise = residual_noise(scenario.model, observer, K, scenario.step, settings, y0)
+    return ActuatorDiagnosis(scenario.model, observer, K, scenario.step, noise, settings)

@@ -19,8 +19,9 @@ class DiagnosisSettings:
 
     observer: the bias observer (by name) whose estimate is the residual; kinds: fault kinds
     hypothesised per actuator; actuators: candidate actuator labels (empty: all); window_s (s):
-    the sliding window of every test; min_window_s (s): the shortest post-alarm record an
-    isolation is decided on; period_s (s): time between decisions; confirm: consecutive decisions
+    the sliding window of every detection test; min_window_s, isolation_window_s (s): the shortest
+    and the longest post-alarm record an isolation is decided on (also the longest record a size is
+    identified on); period_s (s): time between decisions; confirm: consecutive decisions
     that must agree before a state changes; false_alarm_rate: probability that one test of a
     healthy window alarms (Bonferroni-split over the hypotheses); isolation_error_rate: the
     chance that noise alone puts a wrong hypothesis this far ahead of the right one (sets the
@@ -36,6 +37,7 @@ class DiagnosisSettings:
     actuators: tuple[str, ...] = ()
     window_s: float = 2.0
     min_window_s: float = 0.5
+    isolation_window_s: float = 8.0
     period_s: float = 0.1
     confirm: int = 3
     false_alarm_rate: float = 1e-6
@@ -46,15 +48,16 @@ class DiagnosisSettings:
     correct: bool = False
 
     def __post_init__(self):
-        for name in ("window_s", "min_window_s", "period_s", "resolution", "floor"):
+        for name in ("window_s", "min_window_s", "isolation_window_s", "period_s", "resolution", "floor"):
             _positive(name, getattr(self, name))
         for name in ("false_alarm_rate", "isolation_error_rate"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and 0 < value < 1):
                 raise DiagnosisError(f"diagnosis.{name}: expected a probability in (0, 1), got {value!r}")
-        if self.min_window_s > self.window_s:
-            raise DiagnosisError(f"diagnosis.min_window_s: {self.min_window_s} s is longer than "
-                                 f"diagnosis.window_s = {self.window_s} s")
+        if not self.min_window_s <= self.window_s <= self.isolation_window_s:
+            raise DiagnosisError(f"diagnosis.min_window_s, window_s, isolation_window_s: expected min_window_s <= "
+                                 f"window_s <= isolation_window_s, got {self.min_window_s}, {self.window_s}, "
+                                 f"{self.isolation_window_s} s")
         if isinstance(self.confirm, bool) or not isinstance(self.confirm, int) or self.confirm < 1:
             raise DiagnosisError(f"diagnosis.confirm: expected a positive integer (decisions), got {self.confirm!r}")
         if not self.kinds:

@@ -323,7 +323,7 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
                                     if near else "") + f"; known: {', '.join(known)}")
         lists[key] = tuple(value)
     numbers = {key: fields.number(key, getattr(defaults, key), positive=True)
-               for key in ("window_s", "min_window_s", "period_s", "resolution", "floor")}
+               for key in ("window_s", "min_window_s", "isolation_window_s", "period_s", "resolution", "floor")}
     for key in ("false_alarm_rate", "isolation_error_rate"):  # probabilities, checked by DiagnosisSettings
         numbers[key] = fields.raw(key, getattr(defaults, key), "number", "in (0, 1), per test")
     confirm = fields.raw("confirm", defaults.confirm, "integer", ">= 1 (decisions)")
