@@ -135,11 +135,24 @@ def _outcomes(scratch: Path, modules: list[str]) -> dict[str, dict[str, str]]:
     return out
 
 
-def _diff(scratch: Path, name: str) -> str:
-    shown = subprocess.run([str(Path(sys.executable).parent / "mutmut"), "show", name], cwd=scratch,
-                           capture_output=True, text=True)
-    return "\n".join(line for line in shown.stdout.splitlines() if line.startswith(("+", "-"))
-                     and not line.startswith(("+++", "---")))
+_DIFFS = """
+import json, sys
+from pathlib import Path
+from mutmut.mutation.diff_apply import get_diff_for_mutant
+names = json.loads(sys.stdin.read())
+print(json.dumps({n: get_diff_for_mutant(n, path=Path(n.rsplit(".", 1)[0].replace(".", "/") + ".py")) for n in names}))
+"""
+
+
+def _diffs(scratch: Path, names: list[str]) -> dict[str, str]:
+    """The changed lines of each mutant (mutmut's diff without its headers), read in one process in ``scratch``."""
+    if not names:
+        return {}
+    shown = subprocess.run([sys.executable, "-c", _DIFFS], cwd=scratch, input=json.dumps(names), capture_output=True,
+                           text=True, check=True)
+    return {name: "\n".join(line for line in diff.splitlines() if line.startswith(("+", "-"))
+                             and not line.startswith(("+++", "---")))
+            for name, diff in json.loads(shown.stdout).items()}
 
 
 def _dotted(module: str) -> str:
@@ -151,8 +164,7 @@ def _tally(scratch: Path, module: str, statuses: dict[str, str], equivalents: di
            started: str) -> tuple[dict, list[dict], set[str]]:
     """(counts of one module, its unjustified survivors with their diffs, the equivalents that excused one)."""
     survivors, excused = [], set()
-    for name in (n for n, s in statuses.items() if s in ("survived", "no tests")):
-        diff = _diff(scratch, name)
+    for name, diff in _diffs(scratch, [n for n, s in statuses.items() if s in ("survived", "no tests")]).items():
         entry = equivalents.get(name)
         if entry and entry["change"].strip() in diff:
             excused.add(name)
