@@ -253,8 +253,8 @@ def main(argv: list[str] | None = None) -> int:
     prefixes = tuple(_dotted(m) for m in modules)
     stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified)
     saved = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
-    previous = saved.get("before", {}) if args.before else saved
-    if args.merge and previous:
+    previous = saved.get("before") if args.before else saved
+    if args.merge and previous and "modules" in previous:
         per_module = {**{k: v for k, v in previous["modules"].items() if k not in per_module}, **per_module}
         survivors = [s for s in previous["survivors"] if s["module"] not in outcomes] + survivors
         stale = sorted(set(stale) | {n for n in previous.get("stale_equivalents", []) if not n.startswith(prefixes)})
