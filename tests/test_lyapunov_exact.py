@@ -110,6 +110,14 @@ def test_a_P_failing_the_exact_check_falls_back_to_routh_hurwitz(solver_answer):
     assert certificate.details == {"lmi": "the solver's P failed the exact re-check"} and certificate.margin is None
 
 
+def test_a_P_left_by_a_solver_that_failed_is_not_rechecked(solver_answer):
+    """Status infeasible with P = I still in the variable: the answer is the solver's failure (Routh-Hurwitz then
+    proves the single stable vertex), not a proof by that P."""
+    solver_answer(np.eye(2), "infeasible")
+    certificate = lyapunov_decrease("V decreases", [MINUS_I], 0.5, "one matrix")
+    assert certificate.status == "proved" and certificate.details == {"lmi": "LMI status infeasible"}
+
+
 def test_stable_vertices_without_a_common_P_are_inconclusive(solver_answer):
     solver_answer(None, "infeasible")
     other = np.array([[-2.0, 1.0], [0.0, -2.0]])
