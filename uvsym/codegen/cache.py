@@ -8,10 +8,14 @@ CasADi version, so a library is reused only when it would be compiled again byte
 file in it) is always safe. A library is compiled under a temporary name and moved into place with
 ``os.replace``, so two processes compiling the same key at once both end with a whole library.
 An unwritable folder falls back to this process's temporary build folder, with a warning.
+
+Within a process, :func:`memoized` keeps the results of pure builders (symbolic loops, observers,
+loaded libraries) keyed by the value of their arguments (:func:`frozen`), so a rerun redoes nothing.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import itertools
@@ -19,12 +23,15 @@ import os
 import platform
 import subprocess
 import warnings
+from collections import OrderedDict
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Callable
 
 import casadi as ca
+import numpy as np
 
-__all__ = ["CACHE_ENV", "cache_dir", "library_key", "cached_library"]
+__all__ = ["CACHE_ENV", "cache_dir", "library_key", "cached_library", "frozen", "memoized"]
 
 CACHE_ENV = "UVSYM_CACHE_DIR"
 _COUNTER = itertools.count()
@@ -93,3 +100,64 @@ def cached_library(key: str, build: Callable[[Path], None], fallback: Path) -> P
     finally:
         partial.unlink(missing_ok=True)
     return library
+
+
+class _Same:
+    """Hashable stand-in for an object compared by identity (held, so its id is not reused while cached)."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value):
+        self.value = value
+
+    def __hash__(self):
+        return id(self.value)
+
+    def __eq__(self, other):
+        return isinstance(other, _Same) and other.value is self.value
+
+
+def frozen(value):
+    """A hashable key equal for equal values: numbers (floats bit for bit, by ``float.hex``), strings,
+    arrays (dtype, shape, bytes), sequences, mappings (in order) and dataclasses (type and fields) by
+    value, recursively; anything else (CasADi Functions, callables, other objects) by identity."""
+    if value is None or isinstance(value, (bool, str, bytes)):
+        return value
+    if isinstance(value, (int, np.integer)):
+        return ("i", int(value))
+    if isinstance(value, (float, np.floating)):
+        return ("f", float(value).hex())
+    if isinstance(value, np.ndarray):
+        return ("a", value.dtype.str, value.shape, value.tobytes())
+    if isinstance(value, (tuple, list)):
+        return (type(value).__name__, tuple(frozen(v) for v in value))
+    if isinstance(value, Mapping):
+        return ("m", _Same(type(value)), tuple((frozen(k), frozen(v)) for k, v in value.items()))
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return ("d", _Same(type(value)), tuple(frozen(getattr(value, f.name)) for f in dataclasses.fields(value)))
+    return _Same(value)
+
+
+def memoized(maxsize: int):
+    """Decorator: keep the results of the last ``maxsize`` distinct calls, keyed by :func:`frozen` of the
+    arguments (so a changed parameter, gain or fault is a new call). For pure builders of immutable
+    results; ``f.cache_clear()`` empties the memo."""
+
+    def decorate(function):
+        cache: OrderedDict = OrderedDict()
+
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            key = frozen((args, tuple(sorted(kwargs.items()))))
+            if key in cache:
+                cache.move_to_end(key)
+                return cache[key]
+            result = cache[key] = function(*args, **kwargs)
+            if len(cache) > maxsize:
+                cache.popitem(last=False)
+            return result
+
+        wrapper.cache_clear = cache.clear
+        return wrapper
+
+    return decorate

@@ -23,7 +23,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from uvsym.codegen.cache import cached_library, library_key
+from uvsym.codegen.cache import cached_library, library_key, memoized
 from uvsym.errors import CodegenError
 
 __all__ = ["DEFAULT_FLAGS", "FAST_FLAGS", "find_compiler", "compile_function", "compile_roll", "compile_lanes"]
@@ -146,12 +146,14 @@ def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...
     return roll
 
 
+@memoized(16)
 def compile_roll(step: ca.Function, flags: tuple[str, ...] = FAST_FLAGS):
     """A C loop over ``step(z, w) -> (z_next, out)`` (dense vectors), compiled and loaded.
 
     Returns ``roll(z0 (n_z,), W (k, n_w), out (k, n_out)) -> z_end``: k steps, one row of W per
     step, writing each step's ``out`` into the rows of ``out`` (C-contiguous float64 arrays). No
-    state history is kept and nothing is allocated per step.
+    state history is kept and nothing is allocated per step. Memoized in-process by the step object
+    and the flags: a rerun of one loop loads nothing again.
 
     Raises CodegenError when there is no compiler or compilation fails.
     """

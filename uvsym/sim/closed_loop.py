@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault, _check_index, apply_actuator_faults, apply_sensor_faults
@@ -66,6 +67,7 @@ def _by_name(names: tuple[str, ...], available: dict, observer: str):
     return [available[n] for n in names]
 
 
+@memoized(16)
 def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                       actuator_faults: tuple[ActuatorFault, ...] = (),
                       sensor_faults: tuple[SensorFault, ...] = (),
@@ -74,7 +76,8 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     """The closed loop of ``model`` under ``controller`` sampled every ``dt`` seconds.
 
     current: a constant (V_c m/s, beta_c rad) built into the fixed-step path (fewer operations),
-    or None to read the current from each sample's input ``w``.
+    or None to read the current from each sample's input ``w``. Memoized in-process (:func:`~uvsym.sim.loop.memoized`:
+    a rerun with equal arguments, the same model object, shares the loop built first).
     """
     if not dt > 0.0:
         raise SimulationError(f"sample period dt must be positive (s), got {dt}")

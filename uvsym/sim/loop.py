@@ -78,3 +78,4 @@ def fault_summary(fault, target: str) -> dict:
     profile = fault.profile
     return {"target": target, "kind": fault.kind, "value": fault.value, "profile": profile.kind,
             "onset_s": profile.onset, "end_s": None if profile.end == float("inf") else profile.end}
+

@@ -10,12 +10,13 @@ from __future__ import annotations
 import difflib
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.settings import DiagnosisSettings
 from uvsym.errors import (
     DiagnosisError,
@@ -88,15 +89,28 @@ def read_scenario_file(path) -> dict:
     """The parsed TOML table of the scenario file ``path``; ScenarioError when it cannot be read or parsed."""
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text())
+        content = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot be read: {exc}") from None
+    return _table(path, content)
+
+
+def _table(path: Path, content: bytes) -> dict:
+    """The parsed TOML table of a scenario file's bytes (UTF-8, as TOML is); ScenarioError naming ``path``."""
+    try:
+        return tomllib.loads(content.decode())
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
         raise ScenarioError(f"{path}: cannot be read: {exc}") from None
 
 
 def load_scenario(source) -> Scenario:
-    """Read and validate a scenario from a TOML file path or the name of a shipped example."""
+    """Read and validate a scenario from a TOML file path or the name of a shipped example.
+
+    The file is read on every call; its validation is memoized in-process by path and content (a
+    changed file is validated again). Each call returns its own copies of the initial-state arrays.
+    """
     path = Path(source)
     if not path.exists():
         shipped = shipped_scenarios()
@@ -104,7 +118,19 @@ def load_scenario(source) -> Scenario:
             raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
                                    f"shipped: {', '.join(shipped)}")
         path = shipped[str(source)]
-    return parse_scenario(read_scenario_file(path), default_name=path.stem)
+    try:
+        content = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot be read: {exc}") from None
+    scenario = _validated(str(path), content)
+    return replace(scenario, eta0=scenario.eta0.copy(), nu0=scenario.nu0.copy(),
+                   actuators0=None if scenario.actuators0 is None else scenario.actuators0.copy())
+
+
+@memoized(32)
+def _validated(path: str, content: bytes) -> Scenario:
+    """The scenario of a file's bytes, validated (memoized: the same file loaded again is not re-validated)."""
+    return parse_scenario(_table(Path(path), content), default_name=Path(path).stem)
 
 
 def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | None = None) -> Scenario:

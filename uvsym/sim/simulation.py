@@ -7,6 +7,7 @@ from typing import Callable
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import KinematicsError, SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
@@ -189,9 +190,11 @@ def current_profile(scenario: Scenario):
     return np.column_stack([speed, np.full(N + 1, scenario.current[1])])
 
 
+@memoized(16)
 def observer_blocks(model: Model, specs: tuple[ObserverSpec, ...], dt: float) -> tuple[Observer, ...]:
     """The scenario's observers as :class:`~uvsym.observers.base.Observer` sampled every ``dt`` s,
-    named by their kind (f_hat in the kind's unit)."""
+    named by their kind (f_hat in the kind's unit); memoized in-process (gain design and symbolic build
+    are done once per model object, specs and dt)."""
     return tuple(actuator_fault_observer(model, kind, dt, K, form=observer.form, name=kind)
                  for kind, (observer, K) in scenario_observers(model, specs).items())
 
