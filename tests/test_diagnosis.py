@@ -200,3 +200,10 @@ def test_cli_writes_the_decision_log(tmp_path):
     plain = subprocess.run([sys.executable, "-m", "uvsym.cli", "simulate", "docking_faults", "--events",
                             str(tmp_path / "x.json")], capture_output=True, text=True)
     assert plain.returncode != 0 and "[diagnosis]" in plain.stderr
+
+
+def test_a_fault_outside_the_candidates_is_not_blamed_on_them():
+    """Only the thruster and the elevator are candidates; a rudder fault ends no run and is pinned on neither."""
+    events = events_of(docking([("delta_ru", "bias", 0.05, Profile(onset=6.0))], duration=14.0,
+                               actuators=("X", "delta_e")))
+    assert not [e for e in events if e["event"] in ("isolated", "identified")]

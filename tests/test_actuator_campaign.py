@@ -1,0 +1,64 @@
+"""Which runs of the actuator-fault campaign count, and its figures, on hand-made rows and signals."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from derivations.actuator_observers.campaign import counts, metrics, targets
+from uvsym.faults import ActuatorFault, Profile
+from uvsym.sim.scenario import load_scenario
+
+
+def _row(**fields):
+    row = {"status": "ok", "true_actuator": "X", "true_kind": "bias", "identifiable": True, "excited": True,
+           "isolated_actuator": "X", "isolated_kind": "bias", "size_error_rel": 0.01, "isolation_delay_s": 1.0,
+           "false_alarms": 0}
+    return row | fields
+
+
+def test_counts_use_only_identifiable_excited_runs_and_fault_free_false_alarms():
+    rows = [_row(), _row(size_error_rel=0.03, isolation_delay_s=3.0),  # counted: one right, one too far off
+            _row(excited=False, isolated_actuator=None, isolated_kind=None, size_error_rel=None),  # left out
+            _row(true_actuator=None, true_kind=None, false_alarms=2),  # fault-free run with two alarms
+            _row(status="error")]
+    figures = counts(rows)
+    assert figures["campaign_counted_runs"] == 2
+    assert figures["campaign_correct_fraction"] == 0.5
+    assert figures["campaign_correct_fraction_all_faults"] == pytest.approx(1 / 3)
+    assert figures["campaign_false_alarms_no_fault"] == 2
+    assert figures["campaign_crashes"] == 1
+    assert figures["campaign_median_isolation_delay_s"] == 2.0 and figures["campaign_max_isolation_delay_s"] == 3.0
+    met = targets(figures)
+    assert not met["correct fraction >= 0.95 (identifiable, excited)"] and not met["no run crashed"]
+    assert met["median isolation delay <= 5 s"]
+
+
+class _Result:
+    """The part of a SimResult the hook reads: t and u_expected, the third input (delta_ru) set to ``command``."""
+
+    def __init__(self, command: np.ndarray, t: np.ndarray):
+        self.t, self._values = t, np.zeros((len(t), 4))
+        self._values[:, 2] = command
+
+    def __getitem__(self, name):
+        assert name == "u_expected"
+        return SimpleNamespace(values=self._values)
+
+
+def test_excitation_is_judged_from_the_command_after_the_onset():
+    base = load_scenario("docking_faults")
+    rudder = base.model.input_labels.index("delta_ru")
+    scenario = replace(base, actuator_faults=(ActuatorFault(rudder, "proportional", 0.5, Profile(onset=5.0)),))
+    t = np.arange(0.0, 20.0, 0.01)
+    steady = metrics(scenario, _Result(np.full(t.size, 0.1), t), [])
+    assert steady["identifiable"]  # the two rudders differ in roll
+    assert not steady["excited"] and steady["command_variation"] < 1e-12
+    # a command swinging +-0.1 rad (std 0.0707 rad of a 0.524 rad range) after the onset excites it
+    moving = metrics(scenario, _Result(0.1 * np.sin(t), t), [])
+    assert moving["excited"] and moving["command_variation"] == pytest.approx(0.0707 / 0.5236, rel=0.05)
+    # a proportional fault on a command at zero has no effect to see
+    assert not metrics(scenario, _Result(np.zeros(t.size), t), [])["excited"]
