@@ -95,7 +95,7 @@ def test_a_semidefinite_decrease_is_not_a_proof(solver_answer):
 def test_every_vertex_is_rechecked(solver_answer):
     """P = I is fine for -I but not for the unstable second vertex, which refutes the claim."""
     solver_answer(np.eye(2))
-    unstable = np.array([[0.5, 0.0], [0.0, -1.0]])
+    unstable = np.array([[-1.0, 0.0], [0.0, 0.5]])  # the unstable eigenvalue second
     certificate = lyapunov_decrease("hull", [MINUS_I, unstable], 0.1, "two vertices")
     assert certificate.status == "refuted" and certificate.counterexample["A"] == unstable.tolist()
     assert certificate.counterexample["eigenvalue_real"] == 0.5 and certificate.margin == pytest.approx(-0.6)
@@ -135,7 +135,7 @@ def test_the_solver_is_asked_for_the_decrease_at_every_vertex():
     certificate = lyapunov_decrease("hull", vertices, 0.4, "two vertices")
     assert certificate.status == "proved"
     P = np.array(certificate.details["P"])
-    assert np.linalg.eigvalsh(P).min() > 0
+    assert np.linalg.eigvalsh(P).min() > 1.0 - 1e-6  # normalised to P >= I, so that margins compare
     for A in vertices:
         assert np.linalg.eigvalsh(A.T @ P + P @ A + 0.8 * P).max() < 0
 
@@ -165,23 +165,23 @@ def _timed(certificate):
 
 
 def test_a_discrete_refutation_names_the_eigenvalue_by_modulus():
-    """diag(-0.9, 0.2): modulus 0.9 >= rho = 0.5 (its real part, -0.9, would not show it)."""
-    certificate = discrete_lyapunov_decrease("contracts", np.diag([-0.9, 0.2]), 0.5, "one map", expected="refuted")
+    """diag(0.2, -0.9): modulus 0.9 >= rho = 0.5 (its real part, -0.9, would not show it), the second one."""
+    certificate = discrete_lyapunov_decrease("contracts", np.diag([0.2, -0.9]), 0.5, "one map", expected="refuted")
     assert _timed(certificate) == Certificate(
         "contracts", "one map", "Schur test of the sampled map (Moebius map and Routh-Hurwitz in exact rationals): "
         "an eigenvalue of modulus >= rho", "refuted", "refuted", margin=pytest.approx(-0.4),
-        counterexample={"A": [[-0.9, 0.0], [0.0, 0.2]], "eigenvalue_modulus": pytest.approx(0.9), "rho": 0.5,
-                        "eigenvector_real": [1.0, 0.0], "exact_test": "Schur"})
+        counterexample={"A": [[0.2, 0.0], [0.0, -0.9]], "eigenvalue_modulus": pytest.approx(0.9), "rho": 0.5,
+                        "eigenvector_real": [0.0, 1.0], "exact_test": "Schur"})
 
 
 def test_a_discrete_proof_carries_the_stein_P_or_falls_back_to_the_schur_test(monkeypatch):
     a, rho = 0.5, 0.8
     p = 1.0 / (1.0 - (a / ((a + rho) / 2)) ** 2)  # scipy's P = p I (see the closed-form margin above)
-    certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map")
+    certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map", expected="checked")
     np.testing.assert_allclose(certificate.details.pop("P"), p * np.eye(2), rtol=1e-12, atol=1e-12)
     assert _timed(certificate) == Certificate(
         "contracts", "one map", "discrete Lyapunov (Stein) inequality, P from scipy, re-checked by exact rational "
-        "LDL^T", "proved", "proved", margin=pytest.approx(p * (rho**2 - a**2)),
+        "LDL^T", "proved", "checked", margin=pytest.approx(p * (rho**2 - a**2)),
         details={"spectral_radius": pytest.approx(a)})
     import uvsym.verify.lyapunov as lyapunov
 
@@ -191,33 +191,37 @@ def test_a_discrete_proof_carries_the_stein_P_or_falls_back_to_the_schur_test(mo
                 return np.full((2, 2), np.nan)
             raise failure
         monkeypatch.setattr(lyapunov, "solve_discrete_lyapunov", broken)
-        certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map")
+        certificate = discrete_lyapunov_decrease("contracts", a * np.eye(2), rho, "one map", expected="refuted")
         assert _timed(certificate) == Certificate(
             "contracts", "one map", "Schur test in exact rationals (spectral radius < rho, so P exists by "
-            "Lyapunov's theorem)", "proved", "proved",
+            "Lyapunov's theorem)", "proved", "refuted",
             details={"spectral_radius": pytest.approx(a), "stein": "scipy's P failed the exact re-check"})
 
 
 def test_a_P_with_an_indefinite_stein_matrix_is_not_the_proof(monkeypatch):
-    """Ad = 0.5 I, rho = 0.8 with scipy answering P = diag(1, -1): P > 0 fails exactly, so the proof is the exact
-    Schur test, not that P."""
+    """Ad = 0.5 I, rho = 0.8 with scipy answering P = diag(1, -1): P > 0 fails exactly; a Jordan block with P = I:
+    the Stein matrix fails. Either way the proof is the exact Schur test, not that P."""
     import uvsym.verify.lyapunov as lyapunov
 
     monkeypatch.setattr(lyapunov, "solve_discrete_lyapunov", lambda A, Q: np.diag([1.0, -1.0]))
     certificate = discrete_lyapunov_decrease("contracts", 0.5 * np.eye(2), 0.8, "one map")
     assert certificate.status == "proved" and "stein" in certificate.details and certificate.margin is None
+    # P = I > 0 but, for the Jordan block, 0.64 I - Ad^T Ad = [[0.39, -0.5], [-0.5, -0.61]] is indefinite
+    monkeypatch.setattr(lyapunov, "solve_discrete_lyapunov", lambda A, Q: np.eye(2))
+    certificate = discrete_lyapunov_decrease("contracts", np.array([[0.5, 1.0], [0.0, 0.5]]), 0.8, "one map")
+    assert certificate.status == "proved" and "stein" in certificate.details and certificate.margin is None
 
 
 @pytest.mark.parametrize("Ad, rho, message", [
     (np.ones((2, 3)), 0.5, "Ad must be square, got 2x3"),
-    ([[np.nan]], 0.5, "Ad has entries that are not finite"),
+    ([[np.nan]], 0.5, "Ad has entries that are not finite (NaN or inf)"),
     (np.eye(2), 0.0, "rho must be positive, got 0.0"),
     (np.eye(2), -0.5, "rho must be positive, got -0.5"),
     (np.eye(2), "fast", "rho must be a number, got 'fast'"),
     (np.eye(2), np.inf, "rho must be finite, got inf"),
 ])
 def test_discrete_claims_name_the_argument_at_fault(Ad, rho, message):
-    with pytest.raises(VerificationError, match=re.escape(message)):
+    with pytest.raises(VerificationError, match=f"^{re.escape(message)}$"):
         discrete_lyapunov_decrease("contracts", Ad, rho, "one map")
 
 
@@ -227,12 +231,12 @@ def test_discrete_claims_name_the_argument_at_fault(Ad, rho, message):
     ("A", 0.5, "vertices must be a non-empty list of square matrices, got str"),
     ([np.eye(2), np.eye(3)], 0.5, "vertices[1] must be 2x2 like vertices[0], got 3x3"),
     ([np.eye(2), np.ones((2, 3))], 0.5, "vertices[1] must be 2x2 like vertices[0], got 2x3"),
-    ([np.eye(2), [[np.inf, 0.0], [0.0, 1.0]]], 0.5, "vertices[1] has entries that are not finite"),
+    ([np.eye(2), [[np.inf, 0.0], [0.0, 1.0]]], 0.5, "vertices[1] has entries that are not finite (NaN or inf)"),
     ([-np.eye(2)], None, "gamma must be a number, got None"),
     ([-np.eye(2)], np.nan, "gamma must be finite, got nan"),
 ])
 def test_continuous_claims_name_the_argument_at_fault(vertices, gamma, message):
-    with pytest.raises(VerificationError, match=re.escape(message)):
+    with pytest.raises(VerificationError, match=f"^{re.escape(message)}$"):
         lyapunov_decrease("decreases", vertices, gamma, "one matrix")
 
 
