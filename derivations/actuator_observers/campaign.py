@@ -4,8 +4,9 @@ A run counts towards the correct fraction when its fault is *identifiable* and *
 judged from the vehicle's geometry and the simulated commands, never from the diagnosis's own
 verdicts:
 
-- identifiable: the faulty actuator's column of B (at the initial state) is not parallel to any
-  other actuator's (the smallest singular value of the two unit columns side by side is at least
+- identifiable: the faulty actuator's column of B (at the initial state, the actuators at their
+  mean expected values after the onset) is non-zero and not parallel to any other actuator's
+  non-zero one (the smallest singular value of the two unit columns side by side is at least
   ``PARALLEL``): otherwise no measurement can tell the two apart;
 - excited: after the onset (over ``EXCITATION_S``) the actuator's expected value varies by at
   least ``VARIATION`` of its range (fault kinds differ only in how they follow the command) and,
@@ -43,13 +44,15 @@ def metrics(scenario, result, events) -> dict:
         return {"identifiable": None, "excited": None, "command_variation": None, "effect_rms": None}
     fault = scenario.actuator_faults[-1]
     model, a = scenario.model, fault.actuator
-    B = configuration_at(model, scenario.eta0, scenario.nu0, np.zeros(model.n_inputs)).B
-    unit = B / np.maximum(np.linalg.norm(B, axis=0), 1e-300)
-    identifiable = bool(np.linalg.norm(B[:, a]) > 0) and all(
-        np.linalg.svd(unit[:, [a, b]], compute_uv=False)[-1] >= PARALLEL for b in range(model.n_inputs) if b != a)
-    span = float(model.u_max[a] - model.u_min[a])
     after = (result.t >= fault.profile.onset) & (result.t <= fault.profile.onset + EXCITATION_S)
-    command = result["u_expected"].values[after, a]
+    commands = result["u_expected"].values[after]
+    B = configuration_at(model, scenario.eta0, scenario.nu0, commands.mean(axis=0)).B
+    norms = np.linalg.norm(B, axis=0)
+    unit = B / np.maximum(norms, 1e-300)
+    identifiable = bool(norms[a] > 0) and all(np.linalg.svd(unit[:, [a, b]], compute_uv=False)[-1] >= PARALLEL
+                                              for b in range(model.n_inputs) if b != a and norms[b] > 0)
+    span = float(model.u_max[a] - model.u_min[a])
+    command = commands[:, a]
     kind = actuator_kind(fault.kind)
     effect = kind.deliver(command, fault.value) - command
     variation = float(np.std(command)) / span

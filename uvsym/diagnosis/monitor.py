@@ -42,6 +42,8 @@ from uvsym.observers.identification import ActuatorFaultEstimate, configuration_
 
 __all__ = ["ActuatorDiagnosis", "residual_noise"]
 
+_GAUSS_NEWTON_STEPS = 8  # at most, when a decided fault is sized
+
 
 @dataclass
 class _Decided:
@@ -217,11 +219,19 @@ class ActuatorDiagnosis:
                 self._log(k, "cleared", self.labels[a], decided.hypothesis.kind.name)
 
     def _size(self, k: int, actuator: int) -> float:
-        """The size of a decided fault fitted on the record since its onset (at most isolation_window_s)."""
-        rows = np.arange(max(self.decided[actuator].hypothesis.onset, k - self.W_iso + 1), k + 1)
-        fit = self._fit(rows, [])
-        value = fit.theta_model[list(self.decided).index(actuator)]
-        return float(value) if np.isfinite(value) else self.decided[actuator].value
+        """The size of a decided fault fitted on the record since its onset (at most isolation_window_s),
+        Gauss-Newton through the exact force model until the size moves less than 1e-6 of itself."""
+        decided = self.decided[actuator]
+        rows = np.arange(max(decided.hypothesis.onset, k - self.W_iso + 1), k + 1)
+        index = list(self.decided).index(actuator)
+        for _ in range(_GAUSS_NEWTON_STEPS):
+            value = float(self._fit(rows, []).theta_model[index])
+            if not np.isfinite(value):
+                break
+            step, decided.value = value - decided.value, value
+            if abs(step) <= 1e-6 * max(abs(value), 1e-12):
+                break
+        return decided.value
 
     def _revise(self, k: int, rows: np.ndarray, J_model: float) -> None:
         """Re-judge each decided fault's kind, once a window, on a window wholly after its onset: a rival

@@ -33,7 +33,6 @@ from uvsym.models.model import Model
 __all__ = ["RegressorBank", "ResidualNoise"]
 
 _INSIDE = 1e-6  # B is taken this fraction of the actuator's range inside its limits
-SMOOTHING_S = 0.5  # s, time constant of the low-pass the measured state is smoothed with for the regressors
 
 
 @dataclass(frozen=True)
@@ -56,8 +55,7 @@ class RegressorBank:
     (fin angles of attack, propeller loading); its slow part has the density of white noise of
     variance ``(E sigma_n)^2 / (1 - phi)^2``. ``sigma`` (N, n) is the resulting noise level per
     sample and channel, the whitening of every fit. After :meth:`append`, ``r`` is (N, n),
-    ``G`` and ``H`` are (N, m, n): ``F[B_a]`` and ``F[B_a u_e,a]`` per actuator a; ``y`` (N, 2n)
-    the measured state low-passed (time constant SMOOTHING_S) that B and the exact effects read.
+    ``G`` and ``H`` are (N, m, n): ``F[B_a]`` and ``F[B_a u_e,a]`` per actuator a.
     """
 
     def __init__(self, model: Model, P: np.ndarray, dt: float, noise: ResidualNoise):
@@ -83,8 +81,6 @@ class RegressorBank:
         self._effects: dict[tuple, tuple] = {}  # exact fault effects computed so far (see exact)
         self._tau_maps: dict[int, object] = {}  # the force model mapped over so many samples
         self._state = None  # per mode: filter state (lfilter zi) and the last raw regressor
-        self._smooth = float(np.exp(-dt / SMOOTHING_S))
-        self._y_state = None
         self._last = None
         self.r = np.zeros((0, self.n))
         self.G = np.zeros((0, self.m, self.n))
@@ -105,12 +101,6 @@ class RegressorBank:
             return
         u_in = np.clip(u_e, *self._inside)
         n, m = self.n, self.m
-        # the state the regressors are evaluated at is smoothed: B depends on it slowly, and its
-        # sensor noise would otherwise correlate with the noise of the residual
-        if self._y_state is None:
-            self._y_state = np.asarray(y[0], dtype=float)[None] * self._smooth
-        y, self._y_state = scipy.signal.lfilter([1.0 - self._smooth], [1.0, -self._smooth], np.asarray(y, dtype=float),
-                                                axis=0, zi=self._y_state)
         B = np.asarray(self.model.B.raw.map(k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
         slope = np.asarray(self._slope.map(k)(y[:, :n].T, y[:, n:].T, u_e.T)).reshape(n, k, n).transpose(1, 0, 2)
         E = self._E @ slope  # (k, n, n)
