@@ -78,4 +78,3 @@ def fault_summary(fault, target: str) -> dict:
     profile = fault.profile
     return {"target": target, "kind": fault.kind, "value": fault.value, "profile": profile.kind,
             "onset_s": profile.onset, "end_s": None if profile.end == float("inf") else profile.end}
-

@@ -108,7 +108,8 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
             progress((start + k) / N)
     outputs[N] = np.asarray(loop.discrete(z, W[N])[2]).ravel()
     wall = time.perf_counter() - started
-    signals = {name: Signal(outputs[:, sl].copy(), labels, units) for name, (sl, labels, units) in loop.signals.items()}
+    # views of the one logged table (their columns are disjoint): no copy, half the memory
+    signals = {name: Signal(outputs[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
     return SimResult(W[:, 0].copy(), signals, {}), timing
 

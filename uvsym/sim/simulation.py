@@ -102,7 +102,8 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
                                  sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
                                  current=tuple(env) if env.shape == (2,) and not current_in_w else None)
     check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
-    W = sample_inputs(loop.n_w, N, dt, n, seed)  # one row per sample: [t, noise, V_c, beta_c, vec(S), o, D, B]
+    # one row per sample: [t, noise, V_c, beta_c, vec(S), o, D, B]; no draws where no sensor fault reads them
+    W = sample_inputs(loop.n_w, N, dt, n if sensor_faults else 0, seed)
     W[:, loop.env_columns] = env.reshape(-1, 2)
     W[:, loop.correction_columns] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
     W[:, loop.fault_columns] = actuator_fault_columns(loop, tuple(actuator_faults), N)
