@@ -110,3 +110,21 @@ def test_an_unknown_fit_is_refused_with_the_known_ones():
     with pytest.raises(ObserverError, match="unknown isolation fit 'cubic'; known: exponential, line, quadratic"):
         IsolationSettings(fit="cubic")
     assert IsolationSettings() == IsolationSettings(1.0, "exponential", 1e-4, 0.1, 0.05, 0.01)  # the paper's
+
+
+def test_a_record_of_exactly_one_window_predicts_its_last_sample():
+    f_hat = 2.0 - np.exp(-np.outer(T[:W], [5.0, 4.0]))
+    f_bar, _ = predicted_faults(RATES, np.array([5.0, 4.0]), T[:W], f_hat, np.ones((W, 2)), IsolationSettings())
+    assert np.isnan(f_bar[:W - 1]).all() and np.allclose(f_bar[W - 1], 2.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("fit", ["line", "quadratic"])
+def test_a_hidden_channel_is_cut_out_of_a_coupled_error_matrix(fit):
+    """A = [[-5, 1], [2, -0.5]]: channel 2 (rate 0.5 / s) is hidden, so eq. 21 on channel 1 uses A_11 alone:
+    f_bar_1 = f_hat_1 + f_hat_1' / 5 for a linear f_hat_1 = 1 + 2 t."""
+    coupled = SimpleNamespace(error_matrix=ca.Function("A", [ca.SX.sym("tau_d", 2), ca.SX.sym("K", 2)],
+                                                       [ca.DM([[-5.0, 1.0], [2.0, -0.5]])]))
+    f_hat = np.column_stack([1.0 + 2.0 * T, np.cos(T)])
+    f_bar, visible = predicted_faults(coupled, np.zeros(2), T, f_hat, np.ones((len(T), 2)), IsolationSettings(fit=fit))
+    assert visible[:, 0].all() and not visible[:, 1].any() and np.isnan(f_bar[:, 1]).all()
+    np.testing.assert_allclose(f_bar[W - 1:, 0], (1.0 + 2.0 * T + 2.0 / 5.0)[W - 1:], rtol=1e-9)
