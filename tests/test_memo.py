@@ -8,19 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from uvsym.codegen.cache import frozen, memoized
-from uvsym.codegen.compile import compile_roll
+from uvsym.codegen.cache import clear_memos, frozen, memoized
 from uvsym.faults import ActuatorFault, Profile, SensorFault
 from uvsym.models.registry import vehicle
-from uvsym.sim import scenario as scenario_module
 from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.scenario import ObserverSpec, load_scenario, shipped_scenarios
 from uvsym.sim.simulation import observer_blocks, simulate_scenario
-
-
-def _clear_memos():
-    for function in (scenario_module._validated, observer_blocks, build_closed_loop, compile_roll):
-        function.cache_clear()
 
 
 @pytest.fixture(scope="module")
@@ -101,7 +94,7 @@ def test_results_with_filled_memos_equal_those_from_empty_ones(docking):
     faulty = replace(docking, actuator_faults=(ActuatorFault(0, "bias", 20.0, Profile("step", onset=0.5)),))
     warm = [simulate_scenario(docking), simulate_scenario(faulty)]
     again = [simulate_scenario(docking), simulate_scenario(faulty)]
-    _clear_memos()
+    clear_memos()
     cold = [simulate_scenario(docking), simulate_scenario(faulty)]
     for a, b, c in zip(warm, again, cold):
         for name in a.signals:

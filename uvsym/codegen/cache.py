@@ -22,6 +22,7 @@ import itertools
 import os
 import platform
 import subprocess
+import threading
 import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
@@ -31,11 +32,12 @@ from typing import Callable
 import casadi as ca
 import numpy as np
 
-__all__ = ["CACHE_ENV", "cache_dir", "library_key", "cached_library", "frozen", "memoized"]
+__all__ = ["CACHE_ENV", "cache_dir", "library_key", "cached_library", "clear_memos", "frozen", "memoized"]
 
 CACHE_ENV = "UVSYM_CACHE_DIR"
 _COUNTER = itertools.count()
 _WARNED: set[str] = set()
+_MEMOS: list = []  # every memoized function's cache, for clear_memos()
 
 
 def cache_dir() -> Path:
@@ -145,19 +147,30 @@ def memoized(maxsize: int):
 
     def decorate(function):
         cache: OrderedDict = OrderedDict()
+        lock = threading.Lock()  # threads may share the memo; a build runs outside the lock
 
         @functools.wraps(function)
         def wrapper(*args, **kwargs):
             key = frozen((args, tuple(sorted(kwargs.items()))))
-            if key in cache:
-                cache.move_to_end(key)
-                return cache[key]
-            result = cache[key] = function(*args, **kwargs)
-            if len(cache) > maxsize:
-                cache.popitem(last=False)
+            with lock:
+                if key in cache:
+                    cache.move_to_end(key)
+                    return cache[key]
+            result = function(*args, **kwargs)
+            with lock:
+                cache[key] = result
+                if len(cache) > maxsize:
+                    cache.popitem(last=False)
             return result
 
         wrapper.cache_clear = cache.clear
+        _MEMOS.append(cache)
         return wrapper
 
     return decorate
+
+
+def clear_memos() -> None:
+    """Empty every :func:`memoized` function's memo (the next call builds again; the on-disk compile cache stays)."""
+    for cache in _MEMOS:
+        cache.clear()
