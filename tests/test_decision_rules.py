@@ -20,6 +20,7 @@ import pytest
 from uvsym.errors import ObserverError
 from uvsym.models.registry import vehicle
 from uvsym.observers.ftc import Correction
+from uvsym.observers.identification import configuration_at
 from uvsym.observers.isolation import ChannelDecision, IsolationResult, IsolationSettings, Isolator
 from uvsym.observers.supervisor import FaultDiagnosis
 from uvsym.sim.scenario import load_scenario
@@ -180,6 +181,28 @@ def test_a_three_dof_vehicle_reads_its_channels_from_rows_x_y_and_n():
     assert diagnosis.identified["T_R"].value == pytest.approx(0.0, abs=1e-9)
     np.testing.assert_allclose(correction.o, [-10.0, 0.0], atol=1e-9)
     assert diagnosis.decided and diagnosis.isolation_time_s == T[2]
+
+
+def test_an_actuators_kind_is_read_where_it_has_the_largest_share_first_on_a_tie():
+    """The elevator alone acts on Z and M (a share of 1 on both): a tie, so the first of them, Z, names its kind
+    (bias). With its command at 0, tau_d is 0 on both rows and the bias of 2 N on Z alone is, by least squares
+    over the rows Z and M of B, u = b_Z 2 / (b_Z^2 + b_M^2)."""
+    model = vehicle("docking_auv")
+    diagnosis = FaultDiagnosis(model, {"bias": (None, None)}, period=0.3)
+    decided = {c: ("healthy", 0.0) for c in ("X", "Y", "K", "N")} | {"Z": ("bias", 2.0), "M": ("proportional", 0.5)}
+    diagnosis.isolator = StubIsolator([decided])
+    diagnosis.update(T[:3], _signals(3))
+    B = configuration_at(model, np.zeros(6), np.r_[1.5, np.zeros(5)], np.array([20.0, 0.0, 0.0, 0.0])).B
+    b_Z, b_M = B[2, 1], B[4, 1]
+    assert diagnosis.identified["delta_e"].kind == "bias"
+    assert diagnosis.identified["delta_e"].value == pytest.approx(b_Z * 2.0 / (b_Z**2 + b_M**2), rel=1e-9)
+
+
+def test_the_supervisor_defaults_and_takes_its_settings():
+    model = vehicle("docking_auv")
+    assert FaultDiagnosis(model, {"bias": (None, None)}).period == 0.1  # s
+    settings = IsolationSettings(margin=0.5, window_s=2.0)
+    assert FaultDiagnosis(model, {"bias": (None, None)}, settings).isolator.settings is settings
 
 
 class CorrectOnce:
