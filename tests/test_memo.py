@@ -45,10 +45,11 @@ def test_memoized_is_bounded_and_keyed_by_value():
     assert calls == [[1, 2], [3], [4], [1, 2]]
 
 
-def test_a_reloaded_scenario_shares_its_build_but_not_its_arrays(tmp_path):
+def test_a_reloaded_scenario_shares_its_model_but_not_its_arrays_or_controller(tmp_path):
     first, second = load_scenario("docking_faults"), load_scenario("docking_faults")
-    assert second.model is first.model and second.controller is first.controller
+    assert second.model is first.model and frozen(second.controller) == frozen(first.controller)
     assert second.eta0 is not first.eta0 and np.array_equal(second.eta0, first.eta0)
+    assert second.controller.outputs is not first.controller.outputs
     second.eta0[0] = 1e3  # a caller's edit stays its own
     assert load_scenario("docking_faults").eta0[0] == -40.0  # the file's value
     edited = tmp_path / "docking_faults.toml"

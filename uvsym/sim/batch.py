@@ -22,6 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
+from uvsym.codegen.cache import frozen
 from uvsym.codegen.compile import compile_lanes
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
@@ -39,8 +40,8 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
                    supervisor=None) -> list[SimResult]:
     """Each scenario run as :func:`simulate_scenario` (method ``fast``) would, in lanes of shared compiled steps.
 
-    Scenarios share a loop when they share the model and controller objects (e.g. made with
-    ``dataclasses.replace`` from one scenario) and their observers, sensor faults, step and duration;
+    Scenarios share a loop when they share the model object (as loads of one file, or ``dataclasses.replace``
+    of one scenario, do), have equal controllers, observers, sensor faults, step and duration;
     each such group runs in lanes. Results are in the order of ``scenarios``; meta as
     :func:`simulate_scenario`'s plus ``lanes`` (lanes per compiled step), ``wall_s`` being the group's.
 
@@ -60,7 +61,7 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
         if scenario.diagnosis is not None and scenario.diagnosis.correct:
             raise SimulationError(f"scenarios[{i}] ({scenario.name}): its [diagnosis] corrects the commands, a "
                                   "supervisor the lanes cannot run; run it with simulate_scenario")
-        shape = (id(scenario.model), id(scenario.controller), scenario.observers, scenario.sensor_faults,
+        shape = (id(scenario.model), frozen(scenario.controller), scenario.observers, scenario.sensor_faults,
                  scenario.step, scenario.duration)
         groups.setdefault(shape, []).append(i)
     results: list[SimResult | None] = [None] * len(scenarios)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import difflib
 import math
 import tomllib
+from copy import deepcopy
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
@@ -109,7 +110,8 @@ def load_scenario(source) -> Scenario:
     """Read and validate a scenario from a TOML file path or the name of a shipped example.
 
     The file is read on every call; its validation is memoized in-process by path and content (a
-    changed file is validated again). Each call returns its own copies of the initial-state arrays.
+    changed file is validated again). Each call returns its own initial-state arrays and controller
+    (the model is the library's, shared as :func:`~uvsym.models.registry.vehicle` shares it).
     """
     path = Path(source)
     if not path.exists():
@@ -124,7 +126,8 @@ def load_scenario(source) -> Scenario:
         raise ScenarioError(f"{path}: cannot be read: {exc}") from None
     scenario = _validated(str(path), content)
     return replace(scenario, eta0=scenario.eta0.copy(), nu0=scenario.nu0.copy(),
-                   actuators0=None if scenario.actuators0 is None else scenario.actuators0.copy())
+                   actuators0=None if scenario.actuators0 is None else scenario.actuators0.copy(),
+                   controller=deepcopy(scenario.controller))
 
 
 @memoized(32)
