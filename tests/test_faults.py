@@ -163,3 +163,20 @@ def test_registries_round_trip_and_are_read_only():
     assert set(SENSOR_KINDS) == {"bias", "drift", "stuck", "noise"}
     with pytest.raises(TypeError):
         ACTUATOR_KINDS["wobble"] = ACTUATOR_KINDS["bias"]
+
+
+def test_a_kind_with_a_fixed_offset_is_identified_and_corrected_through_its_four_numbers():
+    """deliver(v, f) = v + 2 + f (gain (1, 0), shift (2, 1)): f = delivered - v - 2, and the command v - 2 - f
+    delivers v; no kind in the registry has an s0, so this one is made here."""
+    from uvsym.faults import ActuatorKind
+
+    offset = ActuatorKind("offset", (-math.inf, math.inf), gain=(1.0, 0.0), shift=(2.0, 1.0), healthy=-2.0)
+    assert offset.deliver(5.0, 3.0) == 10.0
+    assert offset.identify(10.0, 5.0) == 3.0
+    assert offset.correction(3.0) == (1.0, -5.0)
+
+
+def test_a_gain_at_the_tolerance_leaves_nothing_to_correct():
+    with pytest.raises(IdentifiabilityError, match="proportional fault of 1e-09 leaves the command no effect"):
+        actuator_kind("proportional").correction(1e-9)
+    assert actuator_kind("proportional").correction(2e-9) == (pytest.approx(5e8), 0.0)
