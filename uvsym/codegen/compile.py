@@ -221,12 +221,14 @@ def _generated(step: ca.Function) -> str:
     return generator.dump()
 
 
+@memoized(16)
 def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_FLAGS):
     """``step(z, w) -> (z_next, out)`` run for ``lanes`` trajectories at once, in a C loop over lanes that
     gcc vectorises (through glibc's vector math library, libmvec, for sin, cos, atan2, exp, ...).
 
     Returns ``roll(z0 (n_z, L), W (k, n_w, L), out (k, n_out, L)) -> z_end (n_z, L)``: k steps of every
-    lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays).
+    lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays). Memoized
+    in-process as :func:`compile_roll` is.
 
     Raises CodegenError when there is no compiler, the step is not straight-line scalar code, or
     compilation (or linking with libmvec) fails.

@@ -182,15 +182,18 @@ def actuator_fault_columns(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], 
     ``(D + c + c D, B + c B + phi b)`` with ``c = phi (g - 1)``.
     """
     m, stages = loop.model.n_inputs, 2 * loop.substeps + 1
-    D, B = np.zeros((N + 1, stages, m)), np.zeros((N + 1, stages, m))
+    columns = np.zeros((N + 1, 2 * stages * m))  # [D_0 .. D_J-1, B_0 .. B_J-1], each (m,): actuator a at j m + a
+    folded: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # actuator -> its (D, B) (N + 1, J), faults in order
     for fault in faults:
         _check_index(fault.actuator, m, "actuator")
         gain, shift = fault.kind_object.affine(fault.value)
         phi = _stage_phi(fault.profile, loop.dt, loop.substeps, N)
         c = phi * (gain - 1.0)
-        d, b = D[:, :, fault.actuator], B[:, :, fault.actuator]
-        D[:, :, fault.actuator], B[:, :, fault.actuator] = d + c + c * d, b + c * b + phi * shift
-    return np.concatenate([D.reshape(N + 1, -1), B.reshape(N + 1, -1)], axis=1)
+        d, b = folded.get(fault.actuator, (0.0, 0.0))
+        folded[fault.actuator] = d + c + c * d, b + c * b + phi * shift
+    for actuator, (d, b) in folded.items():
+        columns[:, actuator:stages * m:m], columns[:, stages * m + actuator::m] = d, b
+    return columns
 
 
 @functools.lru_cache(maxsize=32)
