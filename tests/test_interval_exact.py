@@ -188,6 +188,7 @@ def test_comparisons_are_decided_only_when_the_boxes_settle_them():
     assert decided(ca.OP_EQ, (2, 2), (2, 2)) == (1.0, 1.0)
     assert decided(ca.OP_EQ, (1, 2), (3, 4)) == (0.0, 0.0)
     assert decided(ca.OP_EQ, (1, 3), (2, 2)) is None
+    assert decided(ca.OP_EQ, (2, 2), (2, 3)) is None  # a point against a box that holds it and more
     assert decided(ca.OP_NE, (1, 2), (3, 4)) == (1.0, 1.0)
     assert decided(ca.OP_NE, (2, 2), (2, 2)) == (0.0, 0.0)
 
@@ -228,6 +229,8 @@ def test_fractional_powers_clip_the_box_at_zero():
 
 
 def test_far_from_zero_a_sine_gets_the_whole_range():
+    lo, hi = ia.periodic((np.array([999999.5]), np.array([1000000.5])), np.sin, math.pi / 2, -math.pi / 2)
+    assert (lo[0], hi[0]) == (-1.0, 1.0)  # one end beyond 1e6 is enough
     lo, hi = ia.periodic((np.array([1e7]), np.array([1e7 + 0.1])), np.sin, math.pi / 2, -math.pi / 2)
     assert (lo[0], hi[0]) == (-1.0, 1.0)
     lo, hi = ia.periodic((np.array([-1e7 - 0.1]), np.array([-1e7])), np.cos, 0.0, math.pi)
