@@ -3,7 +3,9 @@
 ``compile_function``: ``casadi.external`` evaluates the compiled code with the same calling
 convention as the original Function, so it is a drop-in replacement. ``compile_roll``: a plain
 C loop over a step Function ``(z, w) -> (z_next, out)``, called once per chunk of steps through
-ctypes -- the fast path of the simulations (see ``benchmarks/sim.py``). ``compile_lanes``: the
+ctypes -- the fast path of the simulations (see ``benchmarks/sim.py``); a step that is straight-line
+code runs as such, on restrict pointers without CasADi's calling convention (faster, results within
+1e-10 relative). ``compile_lanes``: the
 same loop over L independent trajectories side by side, the step's body run as a loop over lanes
 that the compiler vectorises (see ``benchmarks/campaign.py``). Libraries are kept in the compile
 cache (:mod:`uvsym.codegen.cache`), so the same Function is compiled once per machine.
@@ -146,19 +148,48 @@ def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...
     return roll
 
 
+_STRAIGHT = """
+__attribute__((noinline)) static void {name}_body(const double* restrict in0, const double* restrict in1,
+                                                  double* restrict out0, double* restrict out1) {{
+  const long l = 0;
+{body}
+}}
+int {name}_roll(const double* z0, const double* W, double* z_end, double* O, long N) {{
+  double z[{n_z}], z_next[{n_z}];
+  memcpy(z, z0, sizeof z);
+  for (long k = 0; k < N; ++k) {{
+    {name}_body(z, W + k * {n_w}, z_next, O + k * {n_out});
+    memcpy(z, z_next, sizeof z);
+  }}
+  memcpy(z_end, z, sizeof z);
+  return 0;
+}}
+"""
+
+
 @memoized(16)
 def compile_roll(step: ca.Function, flags: tuple[str, ...] = FAST_FLAGS):
     """A C loop over ``step(z, w) -> (z_next, out)`` (dense vectors), compiled and loaded.
 
     Returns ``roll(z0 (n_z,), W (k, n_w), out (k, n_out)) -> z_end``: k steps, one row of W per
     step, writing each step's ``out`` into the rows of ``out`` (C-contiguous float64 arrays). No
-    state history is kept and nothing is allocated per step. Memoized in-process by the step object
-    and the flags: a rerun of one loop loads nothing again.
+    state history is kept and nothing is allocated per step. A step of straight-line scalar code
+    (as :func:`compile_lanes` needs) is compiled as such into the loop, else CasADi's code is called
+    per step. Memoized in-process by the step object and the flags: a rerun of one loop loads nothing again.
 
     Raises CodegenError when there is no compiler or compilation fails.
     """
     n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
-    library = _build(step, _ROLL.format(name=step.name(), n_z=n_z, n_w=n_w, n_out=n_out), flags)
+    sizes = {"name": step.name(), "n_z": n_z, "n_w": n_w, "n_out": n_out}
+
+    def straight() -> str:
+        """The step's body as straight-line code in the loop (one lane of :func:`_lane_body`)."""
+        return _LANE_HELPERS + "#define L 1\n" + _STRAIGHT.format(**sizes, body=_lane_body(step))
+
+    try:
+        library = _build(step, "\0".join((_LANE_HELPERS, _STRAIGHT)), flags, generated=straight)
+    except CodegenError:  # not straight-line code: CasADi's Function called per step
+        library = _build(step, _ROLL.format(**sizes), flags)
     return _roller(step, library, f"{step.name()}_roll", ())
 
 
