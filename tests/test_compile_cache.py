@@ -125,3 +125,23 @@ def test_a_loop_that_diverges_is_reported_alike_with_either_flags(docking_run, m
         messages.append(str(error.value))
     assert messages[0] == messages[1]
 
+
+
+def test_the_straight_line_roll_agrees_with_casadi_s_own_evaluation(docking_run):
+    _, run = docking_run
+    k = 200
+    out = np.empty((k, run.loop.step.nnz_out(1)))
+    z_end = compile_roll(run.loop.step)(run.z0, run.W[:k], out)
+    states, expected = run.loop.step.mapaccum("interpreted", k)(run.z0, run.W[:k].T)  # CasADi's virtual machine
+    scale = np.maximum(np.abs(np.asarray(expected).T), 1.0)
+    assert np.max(np.abs(out - np.asarray(expected).T) / scale) < 1e-10
+    np.testing.assert_allclose(z_end, np.asarray(states)[:, -1], rtol=1e-10, atol=1e-10)
+
+
+def test_a_step_that_calls_another_function_rolls_through_casadi_s_code(compiler_calls):
+    halving = _halving_step()
+    z, w = ca.MX.sym("z"), ca.MX.sym("w")
+    z_next, out = halving(z, w)  # an MX step: its C calls the halving step's, not straight-line code
+    z_end, out = _roll_twice(compile_roll(ca.Function("calling_step", [z, w], [z_next, out], ["z", "w"],
+                                                      ["z_next", "out"])))
+    assert z_end.tolist() == [1.5] and out.ravel().tolist() == [12.0, 9.0]  # as worked by hand above
