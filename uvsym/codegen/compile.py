@@ -5,10 +5,10 @@ convention as the original Function, so it is a drop-in replacement. ``compile_r
 C loop over a step Function ``(z, w) -> (z_next, out)``, called once per chunk of steps through
 ctypes -- the fast path of the simulations (see ``benchmarks/sim.py``); a step that is straight-line
 code runs as such, on restrict pointers without CasADi's calling convention (faster, results within
-1e-10 relative). ``compile_lanes``: the
-same loop over L independent trajectories side by side, the step's body run as a loop over lanes
-that the compiler vectorises (see ``benchmarks/campaign.py``). Libraries are kept in the compile
-cache (:mod:`uvsym.codegen.cache`), so the same Function is compiled once per machine.
+1e-10 relative). ``compile_lanes``: the same loop over L independent trajectories side by side, the
+step's body run as a loop over lanes that the compiler vectorises (see ``benchmarks/campaign.py``).
+Libraries are kept in the compile cache (:mod:`uvsym.codegen.cache`), so the same Function is
+compiled once per machine.
 """
 
 from __future__ import annotations

@@ -76,8 +76,8 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     """The closed loop of ``model`` under ``controller`` sampled every ``dt`` seconds.
 
     current: a constant (V_c m/s, beta_c rad) built into the fixed-step path (fewer operations),
-    or None to read the current from each sample's input ``w``. Memoized in-process (:func:`~uvsym.sim.loop.memoized`:
-    a rerun with equal arguments, the same model object, shares the loop built first).
+    or None to read the current from each sample's input ``w``. Memoized in-process
+    (:func:`~uvsym.codegen.cache.memoized`): a rerun with equal arguments shares the loop built first.
     """
     if not dt > 0.0:
         raise SimulationError(f"sample period dt must be positive (s), got {dt}")

@@ -89,11 +89,15 @@ def shipped_scenarios() -> dict[str, Path]:
 def read_scenario_file(path) -> dict:
     """The parsed TOML table of the scenario file ``path``; ScenarioError when it cannot be read or parsed."""
     path = Path(path)
+    return _table(path, _content(path))
+
+
+def _content(path: Path) -> bytes:
+    """The bytes of a scenario file; ScenarioError naming ``path`` when it cannot be read."""
     try:
-        content = path.read_bytes()
+        return path.read_bytes()
     except OSError as exc:
         raise ScenarioError(f"{path}: cannot be read: {exc}") from None
-    return _table(path, content)
 
 
 def _table(path: Path, content: bytes) -> dict:
@@ -120,11 +124,7 @@ def load_scenario(source) -> Scenario:
             raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
                                    f"shipped: {', '.join(shipped)}")
         path = shipped[str(source)]
-    try:
-        content = path.read_bytes()
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot be read: {exc}") from None
-    scenario = _validated(str(path), content)
+    scenario = _validated(str(path), _content(path))
     return replace(scenario, eta0=scenario.eta0.copy(), nu0=scenario.nu0.copy(),
                    actuators0=None if scenario.actuators0 is None else scenario.actuators0.copy(),
                    controller=deepcopy(scenario.controller))
