@@ -226,8 +226,8 @@ def grid(duration: float, dt: float) -> int:
 
 
 def memory_needed(samples: int, loop: SampledLoop) -> int:
-    """Bytes a run of ``samples`` samples holds at once: the per-sample inputs W, the logged outputs
-    and the result's copy of them (float64)."""
+    """Bytes a run of ``samples`` samples may hold at once: the per-sample inputs W, the logged outputs
+    and one copy of them (float64; a batch rearranges its lanes' outputs, a scalar run's result holds views)."""
     return 8 * samples * (loop.n_w + 2 * loop.discrete.size1_out("out"))
 
 
