@@ -306,3 +306,6 @@ def test_exported_functions_and_package_names_are_checked(tmp_path):
     with pytest.raises(CodegenError, match="unknown precision 'half'; known: double, float"):
         write_package(tmp_path / "c", [exported], "pkg", "half")
     assert not any((tmp_path / name).exists() for name in "abc")  # refused before anything is written
+    (tmp_path / "a_file").write_text("not a folder")
+    with pytest.raises(CodegenError):
+        write_package(tmp_path / "a_file", [exported], "pkg")
