@@ -163,6 +163,12 @@ def _table(**diagnosis):
     ({"noise": {"speed": 0.1}}, "diagnosis.noise.speed"),
     ({"windw_s": 1.0}, "diagnosis.windw_s"),
     ({"min_window_s": 5.0}, "diagnosis.min_window_s"),
+    ({"kinds": ["bias", "bias"]}, "diagnosis.kinds"),
+    ({"actuators": ["X", "X"]}, "diagnosis.actuators"),
+    ({"kinds": ["proportional", "loss_of_effectiveness"]}, "diagnosis.kinds"),
+    ({"window_s": 95.0, "isolation_window_s": 96.0}, "diagnosis.window_s"),
+    ({"period_s": 0.015}, "diagnosis.period_s"),
+    ({"floor": 5.0}, "diagnosis.floor"),
 ])
 def test_bad_diagnosis_tables_name_the_field(diagnosis, field):
     with pytest.raises(ScenarioError, match=field.replace(".", r"\.")):

@@ -196,7 +196,7 @@ def _cmd_simulate(args) -> int:
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
     scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
-    if args.events:
+    if args.events is not None:
         _check_events_path(args.events, scenario, args.force)
     figure = None
     if args.plot is not None:  # the figure checked like the result, before the run
@@ -218,6 +218,8 @@ def _cmd_simulate(args) -> int:
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
+    if scenario is not None and scenario.diagnosis is not None:
+        print(_decisions(result.events))
     if args.events:
         from uvsym.diagnosis.events import write_events_records
 
@@ -228,6 +230,18 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+def _decisions(events: list[dict]) -> str:
+    """One line on what the diagnosis decided: the faults standing at the end (identified or isolated)."""
+    standing = {}
+    for e in events:
+        if e["event"] in ("isolated", "identified"):
+            standing[e["actuator"]] = e
+        elif e["event"] == "cleared":
+            standing.pop(e["actuator"], None)
+    faults = ", ".join(f"{a} {e['kind']} {e['value']:.4g} ({e['event']} at {e['t']:g} s)" for a, e in standing.items())
+    return f"diagnosis: {len(events)} events; faults standing at the end: {faults or 'none'}"
+
+
 def _check_events_path(path, scenario, force: bool) -> None:
     """UvsymError before the run: --events needs a scenario with a [diagnosis] table, a .json file whose
     folder exists, and --force to replace a file."""
@@ -235,7 +249,7 @@ def _check_events_path(path, scenario, force: bool) -> None:
     if scenario is None or scenario.diagnosis is None:
         raise UvsymError("--events: the scenario has no [diagnosis] table, so there is no decision log to write "
                          "(uvsym simulate --schema lists the table's fields)")
-    if target.suffix != ".json":
+    if not str(path).strip() or target.suffix != ".json":
         raise UvsymError(f"--events: {path} must end in .json")
     if not target.parent.is_dir():
         raise UvsymError(f"--events: folder {target.parent} does not exist")

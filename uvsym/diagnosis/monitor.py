@@ -172,7 +172,8 @@ class ActuatorDiagnosis:
         return fit_window(self.bank, rows, model, values, candidates)
 
     def _log(self, k: int, event: str, actuator: str | None, kind: str | None = None, value=None) -> None:
-        self.events.append(Event(float(self._t[k]), event, actuator, kind, None if value is None else float(value)))
+        t = round(float(self._t[k]), 9)  # the sample time, without the float noise of k * dt
+        self.events.append(Event(t, event, actuator, kind, None if value is None else float(value)))
 
     def _decide(self, k: int) -> None:
         rows = np.arange(k - self.W + 1, k + 1)

@@ -60,12 +60,25 @@ class DiagnosisSettings:
                                  f"{self.isolation_window_s} s")
         if isinstance(self.confirm, bool) or not isinstance(self.confirm, int) or self.confirm < 1:
             raise DiagnosisError(f"diagnosis.confirm: expected a positive integer (decisions), got {self.confirm!r}")
+        for name in ("kinds", "actuators"):
+            names = getattr(self, name)
+            if isinstance(names, str) or not all(isinstance(v, str) for v in names):
+                raise DiagnosisError(f"diagnosis.{name}: expected a list of names, got {names!r}")
+            twice = sorted({v for v in names if list(names).count(v) > 1})
+            if twice:
+                raise DiagnosisError(f"diagnosis.{name}: {twice[0]!r} is listed twice")
         if not self.kinds:
             raise DiagnosisError("diagnosis.kinds: at least one fault kind is needed")
         for kind in self.kinds:
             if kind not in ACTUATOR_KINDS:
                 raise DiagnosisError(f"diagnosis.kinds: unknown fault kind {kind!r}; known: "
                                      f"{', '.join(ACTUATOR_KINDS)}")
+        _distinct_kinds(self.kinds)
+        if self.observer != "bias":
+            raise DiagnosisError(f"diagnosis.observer: the residual is the bias observer's estimate, got "
+                                 f"{self.observer!r}")
+        if self.floor > 1:
+            raise DiagnosisError(f"diagnosis.floor: a fraction of the actuators' force, at most 1, got {self.floor}")
         for channel, std in self.noise.items():
             if not (isinstance(std, (int, float)) and math.isfinite(std) and std >= 0):
                 raise DiagnosisError(f"diagnosis.noise.{channel}: expected a standard deviation >= 0, got {std!r}")
@@ -80,6 +93,22 @@ class DiagnosisSettings:
     def isolation_margin(self) -> float:
         """GLR lead (noise variances) the best hypothesis needs over every rival."""
         return float(chdtri(1, self.isolation_error_rate))
+
+
+def _distinct_kinds(kinds) -> None:
+    """DiagnosisError when two listed kinds are one hypothesis: their (gain, shift) lines, ``(g0, s0) + f (g1, s1)``,
+    coincide (e.g. loss of effectiveness ``1 - f`` and proportional ``f``)."""
+    def cross(a, b):
+        return a[0] * b[1] - a[1] * b[0]
+
+    for i, first in enumerate(kinds):
+        for second in kinds[i + 1:]:
+            a, b = ACTUATOR_KINDS[first], ACTUATOR_KINDS[second]
+            da, db = (a.gain[1], a.shift[1]), (b.gain[1], b.shift[1])
+            offset = (b.gain[0] - a.gain[0], b.shift[0] - a.shift[0])
+            if cross(da, db) == 0 and cross(da, offset) == 0:
+                raise DiagnosisError(f"diagnosis.kinds: {first} and {second} are the same hypothesis (one size maps "
+                                     f"onto the other); list one of them")
 
 
 def _positive(name: str, value) -> None:

@@ -187,7 +187,7 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
     controller = _controller(top.table("controller"), model)
     actuator_faults, sensor_faults = _faults(top.tables("faults"), model, duration)
     observers = _observers(top.tables("observers"), model)
-    diagnosis = _diagnosis(top.table("diagnosis"), model, observers, sensor_faults)
+    diagnosis = _diagnosis(top.table("diagnosis"), model, observers, sensor_faults, duration, step)
     top.done()
     return Scenario(name=name, description=description, model=model, duration=duration, step=step, seed=seed,
                     eta0=eta0, nu0=nu0, actuators0=actuators0, current=(V_c, beta_c),
@@ -327,7 +327,7 @@ def _observers(items: list[_Fields], model: Model) -> tuple[ObserverSpec, ...]:
 
 
 def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSpec, ...],
-               sensor_faults: tuple[SensorFault, ...]) -> DiagnosisSettings | None:
+               sensor_faults: tuple[SensorFault, ...], duration: float, step: float) -> DiagnosisSettings | None:
     """The continuous actuator diagnosis (:class:`~uvsym.diagnosis.DiagnosisSettings`), or None
     without a [diagnosis] table. Sensor noise defaults to the scenario's own noise faults that act
     for the whole run (the sensors' specification)."""
@@ -370,6 +370,12 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
                 raise ScenarioError(f"diagnosis.noise.{channel}: unknown measured channel; known: "
                                     f"{', '.join(model.state_labels)}")
     fields.done()
+    if numbers["window_s"] >= duration:
+        raise ScenarioError(f"diagnosis.window_s: {numbers['window_s']:g} s is not shorter than the run "
+                            f"({duration:g} s): no window would ever be tested")
+    if abs(numbers["period_s"] / step - round(numbers["period_s"] / step)) > 1e-9 or numbers["period_s"] < step:
+        raise ScenarioError(f"diagnosis.period_s: {numbers['period_s']:g} s is not a whole number of steps "
+                            f"({step:g} s)")
     try:
         return DiagnosisSettings(observer=name, confirm=confirm, correct=correct, noise=noise, **lists, **numbers)
     except DiagnosisError as exc:
