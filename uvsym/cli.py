@@ -362,6 +362,11 @@ def _cmd_campaign(args) -> int:
 
     campaign = load_campaign(args.file, confirm=args.yes)
     if args.dry_run:
+        from uvsym.campaign.runner import executor_options
+        from uvsym.campaign.worker import load_hook
+
+        load_hook(campaign.settings)
+        executor_options(campaign, args.executor, args.workers, args.scheduler, args.chunk_size)
         print(f"{campaign.name}: {len(campaign.runs)} runs in {len({r.case for r in campaign.runs})} cases, every "
               f"scenario valid; fields: {', '.join(campaign.columns) or 'none'}")
         return 0

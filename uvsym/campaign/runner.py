@@ -13,12 +13,27 @@ from uvsym.campaign.summary import summarize, write_report
 from uvsym.campaign.worker import load_hook
 from uvsym.errors import CampaignError
 
-__all__ = ["run_campaign", "default_out"]
+__all__ = ["run_campaign", "default_out", "executor_options"]
 
 
 def default_out(campaign: Campaign) -> Path:
     """Where a campaign writes when no folder is given: ./campaigns/<name>."""
     return Path("campaigns") / campaign.name
+
+
+def executor_options(campaign: Campaign, executor=None, workers: int | None = None, scheduler: str | None = None,
+                     chunk_size: int | None = None) -> dict:
+    """The campaign's [executor] with the given overrides; CampaignError naming workers or chunk_size below 1."""
+    options = dict(campaign.executor)
+    if executor == "local" and scheduler is None:  # asked for by name: the file's scheduler does not apply
+        options["scheduler"] = None
+    options.update({k: v for k, v in (("workers", workers), ("scheduler", scheduler), ("chunk_size", chunk_size))
+                    if v is not None})
+    for key in ("workers", "chunk_size"):
+        if options[key] is not None and (isinstance(options[key], bool) or not isinstance(options[key], int)
+                                         or options[key] < 1):
+            raise CampaignError(f"{key}: expected an integer >= 1, got {options[key]!r}")
+    return options
 
 
 def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: int | None = None,
@@ -37,20 +52,12 @@ def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: in
     say = log or (lambda line: None)
     store = ResultStore(default_out(campaign) if out_dir is None else out_dir, campaign.name, force)
     load_hook(campaign.settings)
-    options = dict(campaign.executor)
-    if executor == "local" and scheduler is None:  # asked for by name: the file's scheduler does not apply
-        options["scheduler"] = None
-    options.update({k: v for k, v in (("workers", workers), ("scheduler", scheduler), ("chunk_size", chunk_size))
-                    if v is not None})
+    options = executor_options(campaign, executor, workers, scheduler, chunk_size)
     if isinstance(executor, str) or executor is None:
         executor = make_executor(executor or options["kind"], workers=options["workers"],
                                  scheduler=options["scheduler"], timeout_s=options["timeout_s"])
     done = store.finished()
     todo = [run for run in campaign.runs if run.id not in done]
-    for key in ("workers", "chunk_size"):
-        if options[key] is not None and (isinstance(options[key], bool) or not isinstance(options[key], int)
-                                         or options[key] < 1):
-            raise CampaignError(f"{key}: expected an integer >= 1, got {options[key]!r}")
     size = options["chunk_size"]
     chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
     say(f"{campaign.name}: {len(campaign.runs)} runs, {len(campaign.runs) - len(todo)} finished before, "
