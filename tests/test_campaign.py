@@ -250,11 +250,13 @@ def test_metrics_of_a_hand_written_event_log():
 def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
     truth_row = TRUTH | {"end_s": 20.0}
     events = [_event(6.0, "detected"), _event(21.0, "identified", "X", None, 3.0),  # before the clearing: its own
-              _event(22.0, "cleared"), _event(30.0, "detected"), _event(31.0, "unexcited")]
+              _event(22.0, "cleared"), _event(30.0, "detected"), _event(31.0, "unexcited", "X"),
+              _event(32.0, "unexcited", "delta_e")]
     metrics = event_metrics(truth_row, events)
     assert metrics["false_alarms"] == 1 and metrics["detection_delay_s"] == pytest.approx(1.0)
     assert metrics["identified_value"] == 3.0 and metrics["size_error_rel"] == pytest.approx(0.7)
     assert metrics["isolated_actuator"] is None and metrics["unexcited"] is True
+    assert event_metrics(truth_row, [_event(32.0, "unexcited", "delta_e")])["unexcited"] is False
     healthy = {key: None for key in TRUTH} | {"n_faults": 0}
     metrics = event_metrics(healthy, [_event(3.0, "detected"), _event(4.0, "isolated", "X", "bias")])
     assert metrics["false_alarms"] == 2 and metrics["detected"] is False and metrics["detection_delay_s"] is None

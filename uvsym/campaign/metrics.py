@@ -66,7 +66,9 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
     identified_value: the last "identified" value in the window for it (or naming none);
     size_error_rel: ``abs(identified - true) / abs(true)`` (None when true is 0); false_alarms: alarms
-    outside the window (module docstring); ambiguous, unexcited: any such event; events: how many.
+    outside the window (module docstring); ambiguous: any such event; unexcited: such an event naming
+    the run's own actuator or sensor (or none: another actuator's idling is not this run's business);
+    events: how many.
     """
     events = sorted(events, key=lambda e: e["t"])
     target = true["true_actuator"] or true["true_sensor"]
@@ -105,7 +107,7 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
         "false_alarms": sum(e["event"] in ALARMS and not in_window(e) for e in events),
         "ambiguous": any(e["event"] == "ambiguous" for e in events),
-        "unexcited": any(e["event"] == "unexcited" for e in events),
+        "unexcited": any(e["event"] == "unexcited" and e.get("actuator") in (target, None) for e in events),
     }
 
 
