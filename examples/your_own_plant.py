@@ -9,10 +9,10 @@ Run: python examples/your_own_plant.py
 
 import numpy as np
 
-from uvsym.systems import signals, system
 from uvsym.faults import Profile, SensorFault
 from uvsym.observers.luenberger import luenberger_observer
 from uvsym.sim import observer_block, pid, simulate_system
+from uvsym.systems import signals, system
 from uvsym.verify import synthesize_observer_gain
 
 MASS, SPRING, DAMPING = 2.0, 8.0, 1.5  # kg, N/m, N s/m
