@@ -5,13 +5,12 @@ errors. Expected values are the injected faults (by construction) or closed-form
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from uvsym.cli import main
 from uvsym.diagnosis import DiagnosisSettings
 from uvsym.diagnosis.fits import Hypothesis, fit_window
 from uvsym.diagnosis.run import diagnosis_for
@@ -189,23 +188,21 @@ def test_a_diagnosis_needs_the_bias_observer():
         parse_scenario(table)
 
 
-def test_cli_writes_the_decision_log(tmp_path):
+def test_cli_writes_the_decision_log(tmp_path, capsys):
     scenario_file = tmp_path / "late.toml"
     text = shipped_scenarios()["docking_diagnosis"].read_text()
     text = text.replace("duration = 90.0", "duration = 6.0").replace("correct = true", "correct = false")
     scenario_file.write_text(text)
     out = tmp_path / "events.json"
-    run = [sys.executable, "-m", "uvsym.cli", "simulate", str(scenario_file), "--events", str(out)]
-    done = subprocess.run(run, capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
+    assert main(["simulate", str(scenario_file), "--events", str(out)]) == 0
+    assert "faults standing at the end: X bias" in capsys.readouterr().out
     log = json.loads(out.read_text())
     assert [e["event"] for e in log][:2] == ["detected", "isolated"]
     assert all(set(e) == {"t", "event", "actuator", "kind", "value"} for e in log)
-    again = subprocess.run(run, capture_output=True, text=True)
-    assert again.returncode != 0 and "--force" in again.stderr
-    plain = subprocess.run([sys.executable, "-m", "uvsym.cli", "simulate", "docking_faults", "--events",
-                            str(tmp_path / "x.json")], capture_output=True, text=True)
-    assert plain.returncode != 0 and "[diagnosis]" in plain.stderr
+    assert main(["simulate", str(scenario_file), "--events", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert main(["simulate", "docking_faults", "--events", str(tmp_path / "x.json")]) == 2
+    assert "[diagnosis]" in capsys.readouterr().err
 
 
 def test_a_fault_outside_the_candidates_is_not_blamed_on_them():
