@@ -198,6 +198,27 @@ def test_an_actuators_kind_is_read_where_it_has_the_largest_share_first_on_a_tie
     assert diagnosis.identified["delta_e"].value == pytest.approx(b_Z * 2.0 / (b_Z**2 + b_M**2), rel=1e-9)
 
 
+def test_an_entry_of_b_below_its_relative_tolerance_gives_no_authority(monkeypatch):
+    """B's largest entry at 1.5 m/s is about 10.7; an entry of 5e-9 (below 1e-9 of it) on the elevator's X row is
+    numerical dust: the elevator acts on Z and M only, both healthy, so it is healthy despite the fault on X."""
+    import dataclasses
+
+    import uvsym.observers.supervisor as supervisor
+
+    def dusty(model, eta, nu, u):
+        config = configuration_at(model, eta, nu, u)
+        B = np.array(config.B, dtype=float)
+        B[0, 1] = 5e-9
+        return dataclasses.replace(config, B=B)
+
+    monkeypatch.setattr(supervisor, "configuration_at", dusty)
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.3)
+    diagnosis.isolator = StubIsolator([{"X": ("bias", 13.0)} | {c: ("healthy", 0.0) for c in "YZKMN"}])
+    diagnosis.update(T[:3], _signals(3))
+    assert "delta_e" in diagnosis.healthy and "delta_e" not in diagnosis.identified
+    assert diagnosis.identified["X"].value == pytest.approx(13.0, abs=1e-6)
+
+
 def test_the_supervisor_defaults_and_takes_its_settings():
     model = vehicle("docking_auv")
     assert FaultDiagnosis(model, {"bias": (None, None)}).period == 0.1  # s
