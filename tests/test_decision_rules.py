@@ -16,13 +16,15 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from problems import DT, first_order
 
-from uvsym.errors import ObserverError
+from uvsym.errors import ObserverError, SimulationError
 from uvsym.models.registry import vehicle
 from uvsym.observers.ftc import Correction
 from uvsym.observers.identification import configuration_at
 from uvsym.observers.isolation import ChannelDecision, IsolationResult, IsolationSettings, Isolator
 from uvsym.observers.supervisor import FaultDiagnosis
+from uvsym.sim import simulate_system, state_feedback
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import simulate_scenario
 
@@ -258,3 +260,13 @@ def test_an_isolator_needs_an_observer_and_reports_its_faulty_channels_apart():
     decisions = {"X": ChannelDecision("X", "bias", 1.0, 2.0, V), "Y": ChannelDecision("Y", "healthy", 1.5, 0.0, V)}
     result = IsolationResult(T, ("X", "Y"), {}, {}, decisions)
     assert result.faulty == {"X": decisions["X"]}
+
+
+def test_a_supervisor_without_a_period_is_refused_by_name():
+    class Periodless:
+        def update(self, t, signals):
+            return None
+
+    ctrl = state_feedback("p", [[1.0]], reads=["m"], publishes=["F"])
+    with pytest.raises(SimulationError, match="a supervisor needs a positive, finite period"):
+        simulate_system(first_order(0.5, 2.0), [ctrl], duration=0.5, dt=DT, x0=[1.0], supervisor=Periodless())
