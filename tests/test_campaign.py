@@ -377,3 +377,10 @@ def test_a_worker_that_dies_gives_an_error_row_and_the_others_finish(tmp_path):
     assert rows[1]["error"].startswith("WorkerDied") and "exit code 3" in rows[1]["error"]
     assert rows[1]["true_actuator"] == "X"  # truth is known without the run
     assert sorted(_executed(tmp_path)) == [1, 3]
+
+
+def test_a_study_scenario_is_named_as_such(tmp_path):
+    """compass_10deg is shipped with the sensor-fdi-lms study, not as a vehicle scenario: the error says so."""
+    text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1]\n'
+    with pytest.raises(CampaignError, match="scenario of the sensor-fdi-lms study: campaigns take vehicle scenarios"):
+        load_campaign(_write(tmp_path, text))

@@ -1,9 +1,12 @@
 """Campaign files: cases of a scenario swept over a grid and/or Monte Carlo draws, expanded into runs.
 
 A campaign file (TOML) holds ``name``, ``description``, ``max_runs`` (default 1000; more runs need
-confirmation), ``metrics`` (``module:function(scenario, result, events) -> dict`` of extra columns),
+confirmation), ``metrics`` (``module:function(scenario, result, events) -> dict`` of extra columns:
+``scenario`` the run's validated :class:`~uvsym.sim.scenario.Scenario` (its faults as
+``actuator_faults`` and ``sensor_faults``), ``result`` its SimResult, ``events`` its decision log),
 ``roc_by`` (field paths grouping the ROC points), ``[executor]`` (kind, workers, scheduler,
-chunk_size, timeout_s), ``[simulation]`` (method, compiled, substeps: options of
+chunk_size, timeout_s: how long to wait for a Dask scheduler to answer, not a limit per run),
+``[simulation]`` (method, compiled, substeps: options of
 :func:`~uvsym.sim.simulation.simulate_scenario`) and one or more ``[[case]]`` tables: ``name``,
 ``scenario`` (a shipped scenario or a path relative to the campaign file), ``set`` (dotted path ->
 value, every run of the case), ``[case.grid]`` (dotted path -> list of values, full product, in
@@ -186,7 +189,12 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
     if not path.is_file():
         shipped = shipped_scenarios()
         if source not in shipped:
-            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}; "
+            from uvsym.derivation import study_scenarios
+
+            study = study_scenarios().get(source)
+            kind = (f" ({source!r} is a scenario of the {study[0]} study: campaigns take vehicle scenarios)"
+                    if study else "")
+            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}{kind}; "
                                 f"shipped: {', '.join(shipped)}")
         path = shipped[source]
     try:

@@ -70,7 +70,8 @@ class Signal:
 class SimResult:
     """t: (N,) s; signals: name -> Signal (x, y, u_desired, u_command, u_expected, u_actual,
     fault_actuator, fault_sensor, tau_desired, reference, f_hat/<observer>; see ``simulate``);
-    meta: description of the run, JSON-friendly to be saved. Names are non-empty strings without
+    meta: description of the run, JSON-friendly to be saved (``events``: the diagnosis's decision
+    log, see :attr:`events`). Names are non-empty strings without
     control characters; every signal has one row per time."""
 
     t: np.ndarray
