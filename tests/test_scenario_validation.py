@@ -3,6 +3,7 @@ ScenarioError naming the field; a run that reaches the pitch singularity stops t
 
 import copy
 import math
+import re
 
 import pytest
 
@@ -79,3 +80,14 @@ def test_a_run_through_the_pitch_singularity_stops_there_naming_time_and_state(d
     with pytest.raises(SimulationError, match=r"kinematic singularity at t = 0\.\d+ s: the state x.theta = 9\d\.\d+ "
                                               r"deg reached pitch \+-90 deg"):
         simulate_scenario(parse_scenario(table))
+
+
+@pytest.mark.parametrize("patch, field", [({"kind": "stuck"}, "faults[0].kind"),
+                                          ({"profile": "intermittent", "duty": 2.0}, "faults[0].duty"),
+                                          ({"profile": "wobble"}, "faults[0].profile"),
+                                          ({"end": -1.0}, "faults[0].end")])
+def test_a_bad_fault_entry_names_its_field(patch, field):
+    table = read_scenario_file(shipped_scenarios()["docking_faults"])
+    table["faults"] = [dict(table["faults"][0], **patch)]
+    with pytest.raises(ScenarioError, match=re.escape(field) + ":"):
+        parse_scenario(table)

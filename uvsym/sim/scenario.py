@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 import tomllib
 from copy import deepcopy
 from dataclasses import dataclass, replace
@@ -273,24 +274,33 @@ def _faults(items: list[_Fields], model: Model, duration: float):
         try:
             if fields.has("actuator"):
                 label = fields.text("actuator", choices=model.input_labels)
-                fault = ActuatorFault(model.input_labels.index(label), fields.text("kind"),
-                                      fields.number("value"), _profile(fields))
+                kind = fields.text("kind", choices=tuple(ACTUATOR_KINDS))
+                fault = ActuatorFault(model.input_labels.index(label), kind, fields.number("value"), _profile(fields))
                 _check_actuator_value(fields, fault)
                 actuator.append(fault)
             elif fields.has("sensor"):
                 label = fields.text("sensor", choices=model.state_labels)
-                fault = SensorFault(model.state_labels.index(label), fields.text("kind"),
-                                    fields.number("value", 0.0), _profile(fields))
+                kind = fields.text("kind", choices=tuple(SENSOR_KINDS))
+                fault = SensorFault(model.state_labels.index(label), kind, fields.number("value", 0.0),
+                                    _profile(fields))
                 sensor.append(fault)
             else:
                 raise ScenarioError(f"{fields.path}: give either actuator = <input label> or sensor = <state label>")
         except FaultError as exc:
-            raise ScenarioError(f"{fields.path}: {exc}") from None
+            raise ScenarioError(f"{fields.path}.{_fault_field(str(exc))}: {exc}") from None
         if not 0.0 <= fault.profile.onset < duration:
             raise ScenarioError(f"{fields.path}.onset: {fault.profile.onset:g} s is outside the run [0, {duration:g}) "
                                 "s; the fault would never act")
         fields.done()
     return tuple(actuator), tuple(sensor)
+
+
+def _fault_field(message: str) -> str:
+    """The field of a fault table that a FaultError's message is about (its profile parameter, else value)."""
+    if message.startswith("unknown fault profile"):
+        return "profile"
+    named = re.search(r"fault profile (\w+)", message)
+    return named.group(1) if named else "value"
 
 
 def _check_actuator_value(fields: _Fields, fault: ActuatorFault) -> None:
