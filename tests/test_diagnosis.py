@@ -210,3 +210,12 @@ def test_a_fault_outside_the_candidates_is_not_blamed_on_them():
     events = events_of(docking([("delta_ru", "bias", 0.05, Profile(onset=6.0))], duration=14.0,
                                actuators=("X", "delta_e")))
     assert not [e for e in events if e["event"] in ("isolated", "identified")]
+
+
+def test_the_log_is_not_written_into_a_folder_that_does_not_exist(tmp_path):
+    from uvsym.diagnosis.events import write_events_records
+    from uvsym.errors import PathError
+
+    with pytest.raises(PathError, match="does not exist"):
+        write_events_records([], tmp_path / "missing" / "events.json")
+    assert not (tmp_path / "missing").exists()

@@ -13,6 +13,8 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from uvsym.errors import PathError
+
 __all__ = ["EVENTS", "Event", "events_json", "write_events", "write_events_records"]
 
 EVENTS = ("detected", "isolated", "identified", "cleared", "ambiguous", "unexcited")
@@ -46,7 +48,12 @@ def write_events(events: list[Event], path) -> Path:
 
 
 def write_events_records(records: list[dict], path) -> Path:
-    """Write a log already in its JSON form (``SimResult.events``) to ``path``; returns the path."""
+    """Write a log already in its JSON form (``SimResult.events``) to ``path``; returns the path.
+
+    Raises PathError when the folder does not exist (it is not created).
+    """
     path = Path(path)
+    if not path.parent.is_dir():
+        raise PathError(f"cannot write the decision log {path}: folder {path.parent} does not exist")
     path.write_text(json.dumps(records, indent=1) + "\n")
     return path
