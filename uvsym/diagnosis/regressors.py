@@ -79,8 +79,8 @@ class RegressorBank:
         self.Phi = self.V @ np.diag(self.phi) @ self.V_inv
         self._powers: dict[int, np.ndarray] = {}
         self._effects: dict[tuple, tuple] = {}  # exact fault effects computed so far (see exact)
-        self._tau_maps: dict[int, object] = {}  # the force model mapped over so many samples
-        self._state = None  # per mode: filter state (lfilter zi) and the last raw regressor
+        self._maps: dict[tuple, object] = {}  # the model's Functions mapped over so many samples
+        self._state = None  # per mode: filter state (lfilter zi); _last: the last raw regressor
         self._last = None
         self.r = np.zeros((0, self.n))
         self.G = np.zeros((0, self.m, self.n))
@@ -101,23 +101,17 @@ class RegressorBank:
             return
         u_in = np.clip(u_e, *self._inside)
         n, m = self.n, self.m
-        B = np.asarray(self.model.B.raw.map(k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
-        slope = np.asarray(self._slope.map(k)(y[:, :n].T, y[:, n:].T, u_e.T)).reshape(n, k, n).transpose(1, 0, 2)
+        B = np.asarray(self._mapped(self.model.B.raw, k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
+        slope = np.asarray(self._mapped(self._slope, k)(y[:, :n].T, y[:, n:].T, u_e.T))
+        slope = slope.reshape(n, k, n).transpose(1, 0, 2)
         E = self._E @ slope  # (k, n, n)
         slow = (E**2 @ self.noise.velocity_std**2) / np.maximum(1.0 - np.abs(np.diag(self.Phi)), 1e-12) ** 2
         self.sigma = np.concatenate([self.sigma, np.sqrt(self.noise.white**2 + slow)])
         B = B.reshape(n, k, m).transpose(1, 2, 0)  # (k, m, n): column a of B per sample
         raw = np.concatenate([B, B * u_e[:, :, None]], axis=1)  # (k, 2m, n)
-        previous = raw[:1] if self._last is None else self._last[None]
-        averaged = (np.concatenate([previous, raw[:-1]]) + raw) / 2
-        modal = averaged @ self.V_inv.T  # (k, 2m, n) in modal coordinates
         if self._state is None:
-            self._state = np.zeros((n, 1, 2 * m))
-        filtered = np.empty_like(modal)
-        for j in range(n):
-            filtered[:, :, j], self._state[j] = scipy.signal.lfilter(
-                [self.gamma[j]], [1.0, -self.phi[j]], modal[:, :, j], axis=0, zi=self._state[j])
-        filtered = filtered @ self.V.T
+            self._state = np.zeros((1, 2 * m, n))
+        filtered, self._state = self._through_filter(raw, raw[0] if self._last is None else self._last, self._state)
         self._last = raw[-1]
         self.G = np.concatenate([self.G, filtered[:, :m]])
         self.H = np.concatenate([self.H, filtered[:, m:]])
@@ -162,22 +156,33 @@ class RegressorBank:
         u = np.repeat(u_e[None], 3, axis=0)  # healthy, theta - step, theta + step
         u[1, :, actuator] = kind.deliver(u_e[:, actuator], theta - step)
         u[2, :, actuator] = kind.deliver(u_e[:, actuator], theta + step)
-        if 3 * length not in self._tau_maps:
-            self._tau_maps[3 * length] = self.model.tau.raw.map(3 * length)
         eta, nu = np.tile(y[:, :n].T, 3), np.tile(y[:, n:].T, 3)
-        tau = np.asarray(self._tau_maps[3 * length](eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
+        tau = np.asarray(self._mapped(self.model.tau.raw, 3 * length)(eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
         tau = tau.T.reshape(3, length, n)
         low, high = tau[1] - tau[0], tau[2] - tau[0]
         return (low + high) / 2, (high - low) / (2 * step)
 
     def _filter(self, series: np.ndarray) -> np.ndarray:
         """``series`` (L, n) through the observer's filter from a zero state (trapezoidal inputs)."""
-        averaged = (np.concatenate([series[:1], series[:-1]]) + series) / 2
+        return self._through_filter(series, series[0], np.zeros((1, self.n)))[0]
+
+    def _through_filter(self, series: np.ndarray, previous: np.ndarray, state: np.ndarray):
+        """(filtered, state): ``series`` (k, ..., n) through the observer's filter, the trapezoid's input
+        averaged with ``previous`` (..., n) before the first row, from the per-mode ``state`` (1, ..., n)."""
+        averaged = (np.concatenate([previous[None], series[:-1]]) + series) / 2
         modal = averaged @ self.V_inv.T
-        out = np.empty_like(modal)
+        out, state = np.empty_like(modal), state.copy()
         for j in range(self.n):
-            out[:, j] = scipy.signal.lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[:, j])
-        return out @ self.V.T
+            out[..., j], state[..., j] = scipy.signal.lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[..., j],
+                                                              axis=0, zi=state[..., j])
+        return out @ self.V.T, state
+
+    def _mapped(self, function, k: int):
+        """``function`` mapped over k samples, built once per (function, k)."""
+        key = (function.name(), k)
+        if key not in self._maps:
+            self._maps[key] = function.map(k)
+        return self._maps[key]
 
     def transient(self, rows: np.ndarray) -> np.ndarray:
         """(len(rows) n, n) whitened free response ``Phi^j e_i`` of the filter over the window ``rows``."""
