@@ -14,7 +14,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from uvsym.diagnosis.events import write_events_records
+from uvsym.diagnosis.events import write_events
 from uvsym.faults import ActuatorFault, Profile, SensorFault
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import simulate_scenario
@@ -34,5 +34,5 @@ for e in result.events:
     value = "" if e["value"] is None else f" {e['value']:.4g}"
     print(f"{e['t']:6.2f} s  {e['event']:<10} {e['actuator'] or ''} {e['kind'] or ''}{value}")
 out.mkdir(parents=True, exist_ok=True)
-log = write_events_records(result.events, out / "events.json")
+log = write_events(result.events, out / "events.json")
 print(f"wrote {log}")

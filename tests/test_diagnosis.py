@@ -213,9 +213,9 @@ def test_a_fault_outside_the_candidates_is_not_blamed_on_them():
 
 
 def test_the_log_is_not_written_into_a_folder_that_does_not_exist(tmp_path):
-    from uvsym.diagnosis.events import write_events_records
+    from uvsym.diagnosis.events import write_events
     from uvsym.errors import PathError
 
     with pytest.raises(PathError, match="does not exist"):
-        write_events_records([], tmp_path / "missing" / "events.json")
+        write_events([], tmp_path / "missing" / "events.json")
     assert not (tmp_path / "missing").exists()

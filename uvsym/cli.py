@@ -221,9 +221,9 @@ def _cmd_simulate(args) -> int:
     if scenario is not None and scenario.diagnosis is not None:
         print(_decisions(result.events))
     if args.events:
-        from uvsym.diagnosis.events import write_events_records
+        from uvsym.diagnosis.events import write_events
 
-        print(f"wrote {write_events_records(result.events, args.events)} ({len(result.events)} events)")
+        print(f"wrote {write_events(result.events, args.events)} ({len(result.events)} events)")
     if figure is not None:
         result.plot(figure, overwrite=args.force)
         print(f"wrote {figure}")

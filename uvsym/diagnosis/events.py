@@ -15,7 +15,7 @@ from pathlib import Path
 
 from uvsym.errors import PathError
 
-__all__ = ["EVENTS", "Event", "events_json", "write_events", "write_events_records"]
+__all__ = ["EVENTS", "Event", "write_events"]
 
 EVENTS = ("detected", "isolated", "identified", "cleared", "ambiguous", "unexcited")
 
@@ -37,18 +37,8 @@ class Event:
         return record
 
 
-def events_json(events: list[Event]) -> str:
-    """The log as JSON text (a list, one object per event, in time order)."""
-    return json.dumps([e.as_dict() for e in events], indent=1)
-
-
-def write_events(events: list[Event], path) -> Path:
-    """Write the log to ``path`` (JSON); returns the path."""
-    return write_events_records([e.as_dict() for e in events], path)
-
-
-def write_events_records(records: list[dict], path) -> Path:
-    """Write a log already in its JSON form (``SimResult.events``) to ``path``; returns the path.
+def write_events(records: list[dict], path) -> Path:
+    """Write a log in its JSON form (``SimResult.events``, ``Event.as_dict``) to ``path``; returns the path.
 
     Raises PathError when the folder does not exist (it is not created).
     """
