@@ -11,6 +11,9 @@ of a shared machine) and the median, as simulated seconds per wall second.
   built with the default flags;
 - batched: ``compile_lanes`` over ``LANES`` trajectories that differ in seed, faults and current
   (trajectory-seconds per wall second on this one core: nothing runs in parallel);
+- ceilings: the scalar roll with every libm call replaced by a multiply-add (``scalar_math_free``, timed only:
+  wrong dynamics), and that rate times the doubles per vector register, the batched rate if math were free and
+  every lane vectorised perfectly: what this processor could give the targets at best;
 - warm start: a second 100 s docking run in the same process end to end (``load_scenario`` and
   ``simulate_scenario``; the scenario's validation, the observers' gain design, the symbolic loop and
   the loaded library memoized by the first run), the whole call timed, its min and median over repeats;
@@ -30,7 +33,9 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
 from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -41,7 +46,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import finish  # noqa: E402
 
 from uvsym.codegen.cache import clear_memos  # noqa: E402
-from uvsym.codegen.compile import DEFAULT_FLAGS, compile_lanes, compile_roll  # noqa: E402
+from uvsym.codegen.compile import (  # noqa: E402
+    _LANE_HELPERS,
+    _STRAIGHT,
+    _VECTOR_MATH,
+    DEFAULT_FLAGS,
+    FAST_FLAGS,
+    _lane_body,
+    _roller,
+    compile_lanes,
+    compile_roll,
+    find_compiler,
+)
 from uvsym.faults import ActuatorFault, Profile  # noqa: E402
 from uvsym.sim.batch import LANES, simulate_batch  # noqa: E402
 from uvsym.sim.closed_loop import build_closed_loop  # noqa: E402
@@ -103,6 +119,25 @@ class Contender:
                 "ns_per_trajectory_step_median": 1e9 * float(np.median(times)) / (self.steps * self.trajectories)}
 
 
+def math_free_roll(step):
+    """The scalar roll of ``step`` with every call of a libm function (sin, cos, atan2, exp, ...) replaced by one
+    multiply-add on its first argument: wrong dynamics, timed only, as a ceiling on what any faster math library
+    could give the scalar path (built as ``compile_roll`` builds the straight-line step, same flags)."""
+    stand_ins = "".join(f"#define {name}(x, ...) ((x) * 0.999 + 1e-3)\n" for name in _VECTOR_MATH)
+    sizes = {"name": step.name(), "n_z": step.nnz_in(0), "n_w": step.nnz_in(1), "n_out": step.nnz_out(1)}
+    folder = Path(tempfile.mkdtemp(prefix="math-free-"))
+    source, library = folder / "math_free.c", folder / "math_free.so"
+    source.write_text(_LANE_HELPERS + stand_ins + "#define L 1\n" + _STRAIGHT.format(**sizes, body=_lane_body(step)))
+    subprocess.run([find_compiler(), *FAST_FLAGS, str(source), "-o", str(library), "-lm"], check=True)
+    return _roller(step, library, f"{step.name()}_roll", ())
+
+
+def simd_doubles() -> int:
+    """Doubles per vector register of this processor: 8 with AVX-512, 4 with AVX/AVX2, else 2 (SSE2)."""
+    flags = set(Path("/proc/cpuinfo").read_text().split()) if Path("/proc/cpuinfo").exists() else set()
+    return 8 if "avx512f" in flags else 4 if "avx" in flags else 2
+
+
 def interleaved(contenders: dict[str, Contender], dt: float) -> dict[str, dict]:
     """Every contender timed over BATCHES batches, taking turns batch by batch, so that the other users of
     the machine slow them alike."""
@@ -128,7 +163,8 @@ def measure(lanes: int) -> dict:
     n_out = loop.step.nnz_out(1)
     contenders = {"scalar_fast_flags": Contender(compile_roll(scalar.loop.step), scalar.z0, scalar.W, n_out, 1),
                   "scalar_default_flags": Contender(compile_roll(scalar.loop.step, DEFAULT_FLAGS), scalar.z0,
-                                                    scalar.W, n_out, 1)}
+                                                    scalar.W, n_out, 1),
+                   "scalar_math_free": Contender(math_free_roll(scalar.loop.step), scalar.z0, scalar.W, n_out, 1)}
     for count in (lanes, *OTHER_LANES):
         contenders[f"lanes_{count}"] = Contender(
             compile_lanes(loop.step, count), np.ascontiguousarray(np.stack([run.z0 for run in batch[:count]], axis=-1)),
@@ -136,6 +172,7 @@ def measure(lanes: int) -> dict:
     timed = interleaved(contenders, dt)
     scalar_fast, scalar_default, batched = timed["scalar_fast_flags"], timed["scalar_default_flags"], \
         timed[f"lanes_{lanes}"]
+    math_free = timed["scalar_math_free"]
     by_lanes = {count: timed[f"lanes_{count}"] for count in (lanes, *OTHER_LANES)}
     scenarios = scenarios[:lanes]
 
@@ -154,7 +191,7 @@ def measure(lanes: int) -> dict:
     simulate_batch(scenarios, lanes=lanes)
     batch_wall = time.perf_counter() - begun
     return {"load_average_before": load, "scalar_fast_flags": scalar_fast, "scalar_default_flags": scalar_default,
-            "batched": batched,
+            "scalar_math_free": math_free, "batched": batched,
             "batched_by_lanes": {str(k): {"best": v["best"], "median": v["median"]} for k, v in by_lanes.items()},
             "warm_start_s": {"min": min(warm), "median": float(np.median(warm))},
             "warm_start_unmemoized_s": {"min": min(unmemoized), "median": float(np.median(unmemoized))},
@@ -180,6 +217,20 @@ def dask_overhead() -> dict:
     return {"dask_local_overhead": details["dask_local_overhead"], "dask": details}
 
 
+def ceilings(math_free: float, scalar: float) -> dict:
+    """What this processor could give at best: the scalar rate with free math (the math-free roll), and the
+    batched rate per core with free math and every lane in one vector register (``simd_doubles`` x the
+    math-free scalar rate), each beside its target."""
+    width = simd_doubles()
+    batched = width * math_free
+    return {"ceilings": {
+        "scalar_math_free_sim_s_per_wall_s": math_free, "math_share_of_scalar_step": 1.0 - scalar / math_free,
+        "simd_doubles": width, "batched_ceiling_traj_sim_s_per_wall_s_per_core": batched,
+        "scalar_target_reachable_with_free_math": math_free >= TARGETS["scalar_sim_s_per_wall_s_min"],
+        "batched_target_reachable_with_free_math_and_full_vectors":
+            batched >= TARGETS["batched_traj_sim_s_per_wall_s_per_core_min"]}}
+
+
 def main(repeat: int, lanes: int) -> dict:
     runs = []
     for i in range(repeat):
@@ -201,6 +252,7 @@ def main(repeat: int, lanes: int) -> dict:
         "scalar_sim_s_per_wall_s_median": _over(runs, "scalar_fast_flags", "median"),
         "scalar_default_flags_sim_s_per_wall_s": _over(runs, "scalar_default_flags", "best"),
         "scalar_default_flags_sim_s_per_wall_s_median": _over(runs, "scalar_default_flags", "median"),
+        **ceilings(_over(runs, "scalar_math_free", "best"), _over(runs, "scalar_fast_flags", "best")),
         "warm_start_s": _over(runs, "warm_start_s", "min"),
         "warm_start_s_median": _over(runs, "warm_start_s", "median"),
         "warm_start_unmemoized_s": _over(runs, "warm_start_unmemoized_s", "min"),
