@@ -2,6 +2,7 @@
 sample periods of designed blocks, reserved names and the hints of wiring errors."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -87,3 +88,39 @@ def test_a_discrete_plant_steps_its_own_map_in_the_loop():
         simulate_system(plant, [feedback], duration=1.0, dt=0.1, x0=[1.0, 0.0], method="cvodes")
     with pytest.raises(WiringError, match="sampled every 0.1 s, the loop every 0.05 s"):
         interconnect(plant, [feedback], dt=0.05)
+
+
+def test_a_diverging_loop_names_the_first_non_finite_signal_and_the_time():
+    unstable = pid("c", measured="m", reference=1.0, kp=-50.0, output="F", dt=DT)
+    with pytest.raises(SimulationError) as caught:
+        simulate_system(first_order(), [unstable], duration=200.0, dt=DT, x0=[0.0])
+    message = str(caught.value)
+    assert re.search(r"diverged: \w+\.\w+ \((nan|-?inf)\) is non-finite from t = \d", message), message
+    assert "unstable loop" in message
+
+
+def test_available_memory_reads_memavailable_in_kib(monkeypatch):
+    import io
+
+    from uvsym.sim import run
+
+    def fake_open(path, *args, **kwargs):
+        if path != "/proc/meminfo":
+            raise FileNotFoundError(path)
+        return io.StringIO("MemTotal:       16384 kB\nMemFree:     1024 kB\nMemAvailable:    2048 kB\n")
+
+    monkeypatch.setattr(run, "open", fake_open, raising=False)
+    assert run.available_memory() == 2048 * 1024
+
+
+def test_too_much_memory_or_too_many_samples_is_refused_with_both_figures(monkeypatch):
+    from uvsym.sim import run
+
+    monkeypatch.setattr(run, "available_memory", lambda: 1000)
+    with pytest.raises(SimulationError, match=r"^the log needs at least 1.95 KiB of memory, 1000 B are available; "
+                                              r"shorten the run or lengthen the step$"):
+        run.check_memory(2000, "the log")
+    run.check_memory(1000, "the log")  # exactly what is available: taken
+    with pytest.raises(SimulationError, match=r"^duration 1e\+13 s at step 1 s is 1e\+13 samples, more than 1e\+12 "
+                                              r"\(no machine holds them\); shorten the run or lengthen the step$"):
+        run.grid(1e13, 1.0)

@@ -49,6 +49,16 @@ def test_every_integrator_agrees_with_the_fast_path(docking, method, tolerance):
     assert np.abs(other - reference).max() < tolerance
 
 
+def test_an_integrator_feels_the_current_as_the_fast_path_does(docking):
+    from dataclasses import replace
+
+    drifting = replace(_short(docking, 5.0), current=(0.3, 0.5))
+    integrated = simulate_scenario(drifting, method="rk")["x"].values
+    assert np.abs(integrated - simulate_scenario(drifting, method="fast")["x"].values).max() < 1e-3
+    still = simulate_scenario(replace(drifting, current=(0.0, 0.0)), method="rk")["x"].values
+    assert np.abs(integrated - still).max() > 0.1  # 0.3 m/s for 5 s moves the vehicle
+
+
 def test_interpreted_fast_path_equals_compiled(docking):
     short = _short(docking, 2.0)
     compiled = simulate_scenario(short, compiled=True)["x"].values

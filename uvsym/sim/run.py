@@ -217,7 +217,7 @@ def grid(duration: float, dt: float) -> int:
     if not (duration > 0.0 and dt > 0.0 and math.isfinite(duration)):
         raise SimulationError(f"duration and step must be positive and finite, got {duration} s and {dt} s")
     if not duration / dt < MAX_SAMPLES:
-        raise SimulationError(f"duration {duration} s at step {dt} s is {duration / dt:.3g} samples, more than "
+        raise SimulationError(f"duration {duration:g} s at step {dt:g} s is {duration / dt:.3g} samples, more than "
                               f"{MAX_SAMPLES:.0e} (no machine holds them); shorten the run or lengthen the step")
     N = round(duration / dt)
     if abs(N * dt - duration) > 1e-9 * duration:
@@ -255,8 +255,9 @@ def check_memory(needed: int, what: str, error: type[UvsymError] = SimulationErr
 
 
 def _bytes(count: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+    if count < 1024:
+        return f"{count:.0f} B"
+    for unit in ("KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+        count /= 1024
         if count < 1024 or unit == "EiB":
             return f"{count:.3g} {unit}"
-        count /= 1024
-    return f"{count:.3g} EiB"
