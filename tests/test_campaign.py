@@ -379,6 +379,23 @@ def test_a_worker_that_dies_gives_an_error_row_and_the_others_finish(tmp_path):
     assert sorted(_executed(tmp_path)) == [1, 3]
 
 
+def test_a_dask_worker_killed_under_a_chunk_has_the_chunk_rerun_run_by_run(tmp_path):
+    """The worker process dies under the chunk (its nanny starts another): the chunk is resubmitted run by run, one
+    after the other, so the run that kills its worker again gets an error row and takes no other run with it."""
+    distributed = pytest.importorskip("distributed", reason="dask.distributed is not installed "
+                                                            "(pip install 'uvsym[cluster]')")
+    import dask
+
+    campaign = load_campaign(_tiny(tmp_path, "killer", seeds=(2, 3)))
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                     worker_class=distributed.Nanny) as cluster:
+        rows = run_campaign(campaign, tmp_path / "out", scheduler=cluster.scheduler_address, chunk_size=2).to_pylist()
+    assert [r["status"] for r in rows] == ["error", "ok"]
+    assert rows[0]["error"].startswith("KilledWorker") and rows[0]["seed"] == 2
+    assert _executed(tmp_path) == [3]  # once, after the chunk was split (run 2 killed its worker first)
+
+
 def test_a_study_scenario_is_named_as_such(tmp_path):
     """compass_10deg is shipped with the sensor-fdi-lms study, not as a vehicle scenario: the error says so."""
     text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1]\n'

@@ -9,7 +9,7 @@ each chunk completes (its rows in the chunk's order). ``start()`` connects, befo
 during a run gives that run an error row and is replaced, so the other runs go on.
 :class:`DaskExecutor` submits one task per chunk to the scheduler at ``scheduler`` (or to a
 ``LocalCluster`` it starts when none is given); a chunk whose task fails (a worker killed) is
-resubmitted run by run, and a run that fails alone gets an error row.
+resubmitted run by run, one after the other, and a run that fails alone gets an error row.
 """
 
 from __future__ import annotations
@@ -180,28 +180,37 @@ class DaskExecutor:
             self.start()
         futures = {self.client.submit(worker.run_chunk, chunk, settings, pure=False): (index, None)
                    for index, chunk in enumerate(chunks)}
-        parts: dict[int, dict] = {}
+        rows_by_run: dict[int, dict] = {}  # chunk rerun run by run -> the rows so far
         queue = distributed.as_completed(list(futures))
+
+        def submit_next(index: int) -> None:
+            """The next run of failed chunk ``index`` alone, after the one before it has ended: a run that kills
+            its worker then takes no other run of the chunk with it."""
+            run = chunks[index][len(rows_by_run[index])]
+            single = self.client.submit(worker.run_chunk, [run], settings, pure=False)
+            futures[single] = (index, run)
+            queue.add(single)
+
         for future in queue:
             index, alone = futures.pop(future)
             chunk = chunks[index]
             try:
                 rows = future.result()
             except Exception as exc:  # a worker died under the task, or the task could not run
-                if alone is None and len(chunk) > 1:
-                    parts[index] = {}
-                    for run in chunk:  # find the run at fault: each alone
-                        single = self.client.submit(worker.run_chunk, [run], settings, pure=False)
-                        futures[single] = (index, run)
-                        queue.add(single)
+                if alone is None and len(chunk) > 1:  # find the run at fault
+                    rows_by_run[index] = {}
+                    submit_next(index)
                     continue
                 rows = [worker.failure_row(alone or chunk[0], f"{type(exc).__name__}: {exc}")]
             if alone is None:
                 on_chunk(index, rows)
                 continue
-            parts[index][alone.id] = rows[0]
-            if len(parts[index]) == len(chunk):
-                on_chunk(index, [parts.pop(index)[run.id] for run in chunk])
+            rows_by_run[index][alone.id] = rows[0]
+            if len(rows_by_run[index]) < len(chunk):
+                submit_next(index)
+            else:
+                by_run = rows_by_run.pop(index)
+                on_chunk(index, [by_run[run.id] for run in chunk])
 
     def close(self) -> None:
         for resource in (self.client, self.cluster):
