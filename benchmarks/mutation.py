@@ -14,6 +14,8 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 - ``started``, ``seconds``, ``modules_requested``, the mutmut version (``--merge`` keeps the other modules of
   the last results, each with the ``started`` of its own run).
 
+``--results PATH`` writes (and merges into) another file than the committed results.
+
 ``--sample N`` tests N mutants of each module drawn at random (seed 0), an estimate (``sample`` in each module's
 record; the others count as not checked). ``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current
 tests there and tests again only the mutants that were not killed (the tests kept there only add kills, so the
@@ -183,6 +185,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--modules", nargs="+", help="globs or paths of modules to mutate (default: all configured)")
     parser.add_argument("--max-children", type=int, default=1, help="mutants tested at once (default 1: shared cores)")
+    parser.add_argument("--results", type=Path, default=RESULTS,
+                        help="the results file to write (and to merge into); default benchmarks/results/mutation.json")
     parser.add_argument("--keep", type=Path, help="run in this folder and keep it (default: a temporary one)")
     parser.add_argument("--without", nargs="+", default=[],
                         help="test files to leave out (to measure what the other tests kill)")
@@ -252,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
     measured = {name for statuses in outcomes.values() for name in statuses}
     prefixes = tuple(_dotted(m) for m in modules)
     stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified)
-    saved = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    saved = json.loads(args.results.read_text()) if args.results.exists() else {}
     previous = saved.get("before") if args.before else saved
     if args.merge and previous and "modules" in previous:
         per_module = {**{k: v for k, v in previous["modules"].items() if k not in per_module}, **per_module}
@@ -270,11 +274,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{module:<40} {m['killed']:>4} of {m['total']:<4} killed ({rate}), {m['survived']} survived, "
               f"{m['equivalent']} equivalent, {m['not_checked']} not checked")
     if args.before:
-        RESULTS.parent.mkdir(parents=True, exist_ok=True)
-        RESULTS.write_text(json.dumps({**saved, "before": results}, indent=2) + "\n")
-        print(f"wrote the baseline into {RESULTS}")
+        args.results.parent.mkdir(parents=True, exist_ok=True)
+        args.results.write_text(json.dumps({**saved, "before": results}, indent=2) + "\n")
+        print(f"wrote the baseline into {args.results}")
     else:
-        finish({**results, "before": saved.get("before")}, {"lowest_kill_rate_min": TARGET_KILL_RATE}, RESULTS)
+        finish({**results, "before": saved.get("before")}, {"lowest_kill_rate_min": TARGET_KILL_RATE}, args.results)
     return 0 if run.returncode == 0 else 1
 
 
