@@ -157,3 +157,73 @@ def test_untracked_propagation_has_the_same_bands_and_refuses_coefficients():
     np.testing.assert_array_equal(tracked.upper, untracked.upper)
     with pytest.raises(SetError, match="track=True"):
         carry_coefficients(untracked, np.zeros((2, 1)), np.zeros((20, 2, 1)))
+
+
+def test_compiled_kernel_builds_and_reports_its_selection_by_default():
+    """With a C compiler the kernel exists; by default it returns the replaced mask and the box's row sums.
+    G's columns (1, 0), (0, 3), (1, 1), (2, -5): Girard scores 0, 0, 1, 2 replace the first three
+    (count 3), leaving (2, -5) then the box of their absolute row sums (2, 4)."""
+    from uvsym.codegen.compile import find_compiler
+    from uvsym.sets import kernel
+
+    if find_compiler() is None:
+        pytest.skip("no C compiler: only the numpy path exists")
+    G = np.array([[1.0, 0.0, 1.0, 2.0], [0.0, 3.0, 1.0, -5.0]])
+    result = kernel.box_reduce(G, 3, False)
+    assert result is not None
+    new_G, replaced, sums = result
+    np.testing.assert_array_equal(new_G, [[2.0, 2.0, 0.0], [-5.0, 0.0, 4.0]])
+    np.testing.assert_array_equal(replaced, [True, True, True, False])
+    np.testing.assert_array_equal(sums, [2.0, 4.0])
+
+
+def test_pca_reduction_aligns_the_box_with_the_group():
+    """Generators (1, 1), (2, 2), (0.1, -0.1), all replaced (2 kept of 3 in R^2): their principal axes
+    are (1, 1) and (1, -1), so PCA's parallelotope is the set itself, <0, [(3, 3), (0.1, -0.1)]>, with
+    support 0.2 along (1, -1); an axis-aligned box would give 6.2 there."""
+    Z = Zonotope([1.0, -1.0], [[1.0, 2.0, 0.1], [1.0, 2.0, -0.1]])
+    reduced = reduce(Z, 2, "pca").zonotope
+    signs = np.sign(reduced.generators[0])  # the singular vectors' signs are arbitrary
+    np.testing.assert_allclose(reduced.generators * signs, [[3.0, 0.1], [3.0, -0.1]], atol=1e-12)
+    assert reduced.support([1.0, -1.0]) == pytest.approx(2.0 + 0.2, rel=1e-12)
+
+
+def test_point_zonotope_contains_exactly_its_centre():
+    Z = Zonotope([1.0, 2.0], np.zeros((2, 0)))
+    assert Z.contains([1.0, 2.0], tolerance=0.0)
+    assert Z.contains([1.0, 2.0])
+    assert not Z.contains([1.0, 2.0 + 1e-6])
+
+
+def test_box_centre_and_radii():
+    Z = box([0.0, 2.0, 5.0], [2.0, 6.0, 5.0])
+    np.testing.assert_array_equal(Z.center, [1.0, 4.0, 5.0])
+    np.testing.assert_array_equal(Z.generators, [[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]])
+
+
+def test_shape_and_name_in_the_messages():
+    Z = box([-1.0, -1.0], [1.0, 1.0])
+    with pytest.raises(SetError, match=r"^direction must have shape \(2\), got \(3,\)$"):
+        Z.support([1.0, 0.0, 0.0])
+    with pytest.raises(SetError, match=r"^C must have shape \(any, 2\), got \(3, 3\)$"):
+        propagate(np.eye(2) * 0.5, np.eye(3), Z, Z, 5, 4)
+    for A in (0.5, [0.5, 0.5]):  # a scalar or a vector is not a matrix
+        with pytest.raises(SetError, match=r"^A must have shape \(any, any\), got "):
+            propagate(A, np.eye(2), Z, Z, 5, 4)
+    with pytest.raises(SetError, match=r"^initial set must be a Zonotope of dimension 2$"):
+        propagate(np.eye(2) * 0.5, np.eye(2), box([-1.0], [1.0]), Z, 5, 4)
+    with pytest.raises(SetDivergenceError, match=r"eigenvalues of modulus >= 1: \[1\.234568\]$"):
+        propagate([[1.2345678]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 5, 2)
+    untracked = propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 3, 2, track=False)
+    with pytest.raises(SetError, match=r"^the propagation kept no coefficient maps: propagate it with track=True$"):
+        carry_coefficients(untracked, np.zeros((1, 1)), np.zeros((3, 1, 1)))
+
+
+def test_growth_guard_measures_the_radius_at_any_offset_and_scale():
+    """x+ = x / 2 + w from |x0 - 10| <= 1, |w| <= 1: centre 10 / 2^k, radius 2^-k + 2 (1 - 2^-k), well within
+    the default limit; the guard at limit 0.5 still fires when the whole problem is scaled by 1e-9."""
+    result = propagate([[0.5]], [[1.0]], box([9.0], [11.0]), box([-1.0], [1.0]), 6, generators=2)
+    k = np.arange(6)
+    np.testing.assert_allclose(result.upper[:, 0], 10 * 0.5 ** k + 0.5 ** k + 2 * (1 - 0.5 ** k), rtol=1e-12)
+    with pytest.raises(SetDivergenceError, match="reduction wraps"):
+        propagate([[0.5]], [[1.0]], box([-1e-9], [1e-9]), box([-1e-9], [1e-9]), 3, 2, growth_limit=0.5)
