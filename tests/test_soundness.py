@@ -4,6 +4,7 @@ its regression here; bad inputs get typed errors. (A larger sample: benchmarks/s
 
 from __future__ import annotations
 
+import math
 import time
 from fractions import Fraction
 
@@ -11,7 +12,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from uvsym.errors import VerificationError
+from uvsym.errors import UvsymError, VerificationError
 from uvsym.testing import assert_checked, assert_proved, assert_refuted
 from uvsym.verify import Certificate, lyapunov_decrease, prove_identity, region_decrease, synthesize_observer_gain
 from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
@@ -116,6 +117,40 @@ def test_synthesis_certifies_the_exact_closed_loop():
     assert F[0][0] + F[1][1] < 0 and F[0][0] * F[1][1] - F[0][1] * F[1][0] > 0
 
 
+def test_synthesis_reaches_a_rate_just_below_an_unobservable_mode_and_says_what_it_tried_beyond():
+    """The mode at -1 is not seen by C: A - L C keeps it, so every rate below 1 1/s is reachable (decay 0 too) and
+    none above; the LMI is ``A'P + PA - C'Y' - YC + 2 rate P < 0``, feasible exactly for rate < 1."""
+    A, C = np.diag([-1.0, 0.5]), np.array([[0.0, 1.0]])
+    for decay in (0.0, 0.8):
+        L = synthesize_observer_gain(A, C, decay=decay).L
+        assert max(np.linalg.eigvals(A - L @ C).real) <= -decay
+    with pytest.raises(UvsymError, match=r"^no observer gain with decay 1.2 1/s: the LMI at 1.212 1/s: "
+                                         r"infeasible and at 1.2 1/s: infeasible$"):
+        synthesize_observer_gain(A, C, decay=1.2)
+
+
+def test_a_jump_that_every_derivative_misses_is_never_proved():
+    """W = V' + gamma x'x with x' = -x + c (ceil x - floor x): CasADi's derivatives of ceil and floor are 0, so the
+    Hessian of W is -2 + 2 gamma everywhere, yet W = 2 c x - (2 - gamma) x^2 > 0 for 0 < x < 2 c / (2 - gamma)."""
+    x, c, gamma = ca.SX.sym("x"), 1e-9, 0.5
+    certificate = region_decrease("jump", x * x, -x + c * (ca.ceil(x) - ca.floor(x)), x, gamma, [-1.0], [1.0], 0.1,
+                                  max_boxes=20_000)
+    point = 1e-12
+    assert 2 * point * (-point + c * (math.ceil(point) - math.floor(point))) + gamma * point ** 2 > 0
+    assert certificate.status != "proved"
+
+
+def test_a_loop_whose_equilibrium_is_not_at_zero_gets_no_taylor_cube():
+    """V = x^2 + x has V' = (2 x + 1) x' != 0 at x = 0 for x' = -x - 0.01: the cube argument needs W(0) = 0 and a
+    zero gradient there; W < 0 on the rest of the box, so the claim is left open with that reason."""
+    x = ca.SX.sym("x")
+    certificate = region_decrease("offset", x * x + x, -x - 0.01, x, 0.01, [-0.001], [1.0], 0.0005,
+                                  max_boxes=20_000)
+    assert certificate.status == "inconclusive"
+    assert certificate.reason.startswith("W or its gradient at x = 0 is not exactly 0 in interval arithmetic (is x = 0 "
+                                         "an equilibrium of the loop?); no counterexample outside it")
+
+
 def test_identity_findings():
     x = ca.SX.sym("x")
     relative = prove_identity("1e-13", x * (1 + 1e-13), x, [x], "all x")
@@ -170,6 +205,8 @@ def test_bad_inputs_get_typed_errors_naming_the_argument():
         (lambda: synthesize_observer_gain([[np.nan]], [[1.0]], 1.0), "A"),
         (lambda: synthesize_observer_gain(np.eye(2), np.ones((1, 3)), 1.0), "columns"),
         (lambda: synthesize_observer_gain(-np.eye(2), np.ones((1, 2)), np.nan), "decay"),
+        (lambda: synthesize_observer_gain(-np.eye(2), np.ones((1, 2)), -0.5), "decay must be a finite rate >= 0"),
+        (lambda: synthesize_observer_gain([[-1.0]], [[np.inf]], 1.0), "^C has entries that are not finite"),
         (lambda: IntervalFunction(ca.Function("f", [x], [x]))([[np.nan, 0]], [[1, 1]]), "NaN"),
         (lambda: Certificate("c", "s", "m", "maybe"), "status"),
     ]
