@@ -39,12 +39,12 @@ import sympy
 from uvsym.errors import VerificationError as LMIError
 from uvsym.verify.certificate import Certificate
 from uvsym.verify.lyapunov import exact_positive_definite
+from uvsym.verify.synthesis import DESIGN_MARGIN
 
 __all__ = ["BlockGains", "BlockLMI", "block_lmi", "block_lmi_claim", "dual_certificate",
            "exact_positive_semidefinite", "solve_block_lmi"]
 
 Matrix = list[list[Fraction]]
-DESIGN_MARGIN = 1.01  # the LMI is solved for 1 % more than the rate it certifies
 DENOMINATORS = (10**3, 10**6, 10**9)  # rational roundings tried for a dual certificate
 CHECK = "Z >= 0, C_i Z_ii = 0, [Omega Z + Z Omega^T + 2 alpha Z]_ii >= 0 in exact rationals"
 
