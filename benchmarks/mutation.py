@@ -16,11 +16,11 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 
 ``--results PATH`` writes (and merges into) another file than the committed results.
 
-``--sample N`` tests N mutants of each module drawn at random (seed 0), an estimate (``sample`` in each module's
-record; the others count as not checked). ``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current
-tests there and tests again only the mutants that were not killed (the tests kept there only add kills, so the
-result is that of a full run with the current tests on the source copied then). ``--before --tests-at COMMIT``
-records a baseline with an earlier commit's tests under the key ``before``.
+``--sample N`` tests N mutants of each module drawn at random (seeded by the module's path), an estimate
+(``sample`` in each module's record; the others count as not checked). ``--keep FOLDER`` keeps the copy;
+``--again FOLDER`` brings the current tests there and tests again only the mutants that were not killed (the tests
+kept there only add kills, so the result is that of a full run with the current tests on the source copied then).
+``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests under the key ``before``.
 """
 
 from __future__ import annotations
@@ -199,7 +199,8 @@ def main(argv: list[str] | None = None) -> int:
                              "the mutants that were not killed (tests kept there only add kills); with --sample, "
                              "only those of the sample tested there")
     parser.add_argument("--sample", type=int, metavar="N",
-                        help="test N mutants of each module drawn at random (seed 0): an estimate, not a full run")
+                        help="test N mutants of each module drawn at random (seeded by its path): an estimate, "
+                             "not a full run")
     parser.add_argument("--before", action="store_true",
                         help="record this run as the baseline (key 'before') and leave the last results as they are")
     args = parser.parse_args(argv)
@@ -232,9 +233,9 @@ def main(argv: list[str] | None = None) -> int:
         if args.sample and not args.again:  # generate the mutants and test statistics, test none, draw the sample
             subprocess.run(["nice", "-n", "15", mutmut, "run", "no-mutant-is-named-so*"], cwd=scratch, env=env,
                            capture_output=True, text=True)
-            draw = random.Random(0)
-            for statuses in _outcomes(scratch, modules).values():
+            for module, statuses in _outcomes(scratch, modules).items():
                 pending = sorted(n for n, s in statuses.items() if s not in KILLED | {"survived"})
+                draw = random.Random(module)  # the same draw whatever other modules the run takes
                 names += sorted(draw.sample(pending, min(args.sample, len(pending))))
         run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children), *names],
                              cwd=scratch, env=env, capture_output=True, text=True)
