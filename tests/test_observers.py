@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from uvsym import fixed_thrusters, vectored_thrusters, vehicle
-from uvsym.errors import FaultError, IdentifiabilityError, ObserverError
+from uvsym.errors import ArgumentError, FaultError, IdentifiabilityError, ObserverError
 from uvsym.faults import ActuatorFault, apply_actuator_faults
 from uvsym.observers import KINDS, actuator_observer
 from uvsym.observers.discrete import sampled_observer
@@ -310,3 +310,89 @@ def test_observer_functions_have_the_named_signature_and_an_init(builder):
     eta, nu, tau_d, K = np.array([1.0, 2.0, 0.3]), np.array([1.2, 0.1, 0.05]), np.array([40.0, 3.0, 8.0]), np.ones(3)
     x0 = observers.init_state(function, eta, nu, tau_d, K)
     np.testing.assert_allclose(np.asarray(function(x0, eta, nu, tau_d, K)[1]).ravel(), 0.0, atol=1e-12)
+
+
+def test_a_model_name_or_other_object_is_refused_with_the_right_hint():
+    with pytest.raises(ObserverError, match=r"got str 'otter3dof' \(build it with uvsym.vehicle\('otter3dof'\)\)$"):
+        actuator_observer(OTTER, "bias")
+    with pytest.raises(ObserverError, match=r"^model must be a uvsym Model, got int 42$"):  # no hint for a non-name
+        actuator_observer(42, "bias")
+
+
+def test_observer_symbols_and_entries_carry_fossens_names():
+    # 6 DOF: the restoring forces g(eta) depend on roll and pitch (eta entries phi, theta), so x_dot reads eta_3, eta_4
+    from uvsym.sympy_bridge import to_sympy
+
+    observer = actuator_observer(vehicle("docking_auv"), "bias", "momentum")
+    raw = observer.function.raw
+    x_dot = raw.call(raw.sx_in())[0]
+    names = {s.name for s in to_sympy(x_dot).free_symbols}
+    assert {"eta_3", "eta_4"} <= names
+    assert {name.rsplit("_", 1)[0] for name in names} == {"x", "eta", "nu", "tau_d", "K"}
+    assert observer.L.name_in() == ["nu", "tau_d", "K"] and observer.R.name_in() == ["nu", "tau_d", "K"]
+    # a bad entry is named by its force label (X, Y, Z, K, M, N)
+    zeros, ones = np.zeros(6), np.ones(6)
+    with pytest.raises(ArgumentError, match=r"bias_observer: argument x entry Z is nan"):
+        observer.function(np.r_[0.0, 0.0, np.nan, 0.0, 0.0, 0.0], zeros, zeros, ones, ones)
+    with pytest.raises(ArgumentError, match=r"bias_observer: argument K entry M is inf"):
+        observer.function(zeros, zeros, zeros, ones, np.r_[1.0, 1.0, 1.0, 1.0, np.inf, 1.0])
+    with pytest.raises(ArgumentError, match=r"\.L: argument K entry Y is inf"):
+        observer.L(zeros, ones, np.r_[1.0, np.inf, 1.0, 1.0, 1.0, 1.0])
+
+
+def test_design_gains_messages_name_the_mistake():
+    observer = actuator_observer(vehicle(OTTER), "proportional")
+    tau_d = np.array([40.0, 3.0, 10.0])
+    with pytest.raises(ObserverError, match=r"got CheckedFunction \(pass the observer, not its .function\)"):
+        design_gains(observer.function, 0.5, tau_d)
+    with pytest.raises(ObserverError, match=r"^time_constant must be positive and finite \(s\), got -0.5$"):
+        design_gains(observer, -0.5, tau_d)
+    with pytest.raises(ObserverError, match=r"^tau_d must have 3 finite entries, got \[1.0, 2.0\]$"):
+        design_gains(observer, 0.5, [1, 2])
+    with pytest.raises(ObserverError, match=r"^tau_d must be 3 numbers \(N, N m\), got \['a', 'b', 'c'\]$"):
+        design_gains(observer, 0.5, ["a", "b", "c"])
+    with pytest.raises(ObserverError, match=r"^tau_d = \[0.0, 0.0, 0.0\] is zero in every channel: the proportional "
+                                            r"observer sees no fault in any of them \(Remark 2"):
+        design_gains(observer, 0.5, np.zeros(3))
+
+
+def test_unobservable_channels_check_tau_d():
+    observer = actuator_observer(vehicle(OTTER), "proportional")
+    assert unobservable_channels(observer, [40, 0, -1e-7]) == (1, 2)  # |tau_d,i| <= 1e-6 N
+    with pytest.raises(ObserverError, match=r"^tau_d must be 3 numbers \(N, N m\), got 'abc'$"):
+        unobservable_channels(observer, "abc")
+    with pytest.raises(ObserverError, match=r"^tau_d must have 3 finite entries, got \[40.0, nan, 1.0\]$"):
+        unobservable_channels(observer, [40.0, np.nan, 1.0])  # nan is not "observable"
+
+
+def test_stopped_actuator_is_commanded_zero_while_the_others_saturate():
+    # B = [[1, 1, 1], [0, 1, -1]]; a stuck at 0 is stopped and its 3 N of X go to b, c: pinv([[1, 1], [1, -1]]) [3, 0]
+    # = [1.5, 1.5], so u_lin = [0, 5.5, 2.5]; b is capped at 5 and c stays at 2.5 (B_bc is square and invertible:
+    # |B_bc (u - u_lin)| = |(-0.5 + dc, -0.5 - dc)| is least at dc = 0)
+    B = np.array([[1.0, 1.0, 1.0], [0.0, 1.0, -1.0]])
+    estimate = {"a": ActuatorFaultEstimate("a", "constant", 0.0, 0.0)}
+    u_star = corrected_commands([3.0, 4.0, 1.0], estimate, ("a", "b", "c"), B, np.full(3, -5.0), np.full(3, 5.0))
+    assert u_star[0] == 0.0  # stopped: no command at all, not the edge of its +-1e-12 band
+    np.testing.assert_allclose(u_star[1:], [5.0, 2.5], atol=1e-9)
+
+
+def test_a_positive_bias_leaves_the_lower_bound_of_the_command_alone():
+    # a bias of +3 delivers u + 3: the command must keep u in [-10, 10] and u + 3 in [-10, 10], so u in [-10, 7];
+    # u_d = -6 gives u* = -9, inside that range, so it is returned unchanged and delivers -6
+    estimate = {"a": ActuatorFaultEstimate("a", "bias", 3.0, 0.0)}
+    u_star = corrected_commands([-6.0, 1.0], estimate, ("a", "b"), np.eye(2), np.full(2, -10.0), np.full(2, 10.0))
+    np.testing.assert_array_equal(u_star, [-9.0, 1.0])
+    # the upper bound moves by the bias: u_d = 10 needs u* = 7, the edge, still inside
+    u_star = corrected_commands([10.0, 1.0], estimate, ("a", "b"), np.eye(2), np.full(2, -10.0), np.full(2, 10.0))
+    np.testing.assert_allclose(u_star, [7.0, 1.0], atol=1e-12)
+
+
+def test_configuration_labels_and_exact_equilibrium_values():
+    from fractions import Fraction
+
+    config = configuration_at(vehicle("docking_auv"), np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), np.zeros(4))
+    assert config.labels == ("X", "delta_e", "delta_ru", "delta_rd")  # the model's inputs: thrust, elevator, rudders
+    u_e = [Fraction(1, 2), Fraction(-1, 8), Fraction(1, 16), Fraction(0)]
+    u = actuator_values(config, np.zeros(6), u_e=u_e)  # tau = tau_e: u = u_e exactly
+    assert u.dtype == np.float64
+    np.testing.assert_array_equal(u, [0.5, -0.125, 0.0625, 0.0])

@@ -34,11 +34,24 @@ class GainDesign:
 def unobservable_channels(observer: ActuatorObserver, tau_d, threshold: float = 1e-6) -> tuple[int, ...]:
     """Channels where a proportional fault cannot be seen (Remark 2): ``|tau_d,i| <= threshold`` (N, N m).
 
-    Always empty for observers of kinds that do not scale tau_d (bias, constant).
+    Always empty for observers of kinds that do not scale tau_d (bias, constant). ObserverError for a
+    tau_d that is not (n,) finite numbers.
     """
     if not actuator_kind(observer.kind).scales:
         return ()
-    return tuple(int(i) for i in np.flatnonzero(np.abs(np.asarray(tau_d, float).ravel()) <= threshold))
+    tau_d = _desired_action(tau_d, observer.function.size1_in("x"))
+    return tuple(int(i) for i in np.flatnonzero(np.abs(tau_d) <= threshold))
+
+
+def _desired_action(tau_d, n: int) -> np.ndarray:
+    """tau_d as (n,) finite floats (N, N m); ObserverError naming tau_d otherwise."""
+    try:
+        tau_d = np.asarray(tau_d, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ObserverError(f"tau_d must be {n} numbers (N, N m), got {tau_d!r:.60}") from None
+    if tau_d.size != n or not np.all(np.isfinite(tau_d)):
+        raise ObserverError(f"tau_d must have {n} finite entries, got {tau_d.tolist()}")
+    return tau_d
 
 
 def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -> GainDesign:
@@ -65,12 +78,7 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
         if actuator_kind(observer.kind).scales:
             raise ObserverError(f"the {observer.kind} observer's rate depends on tau_d: pass the nominal tau_d")
         tau_d = np.ones(n)
-    try:
-        tau_d = np.asarray(tau_d, dtype=float).ravel()
-    except (TypeError, ValueError):
-        raise ObserverError(f"tau_d must be {n} numbers (N, N m), got {tau_d!r:.60}") from None
-    if tau_d.size != n or not np.all(np.isfinite(tau_d)):
-        raise ObserverError(f"tau_d must have {n} finite entries, got {tau_d.tolist()}")
+    tau_d = _desired_action(tau_d, n)
     unobservable = unobservable_channels(observer, tau_d)
     if len(unobservable) == n:
         raise ObserverError(f"tau_d = {tau_d.tolist()} is zero in every channel: the {observer.kind} observer sees "
