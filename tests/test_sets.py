@@ -227,3 +227,37 @@ def test_growth_guard_measures_the_radius_at_any_offset_and_scale():
     np.testing.assert_allclose(result.upper[:, 0], 10 * 0.5 ** k + 0.5 ** k + 2 * (1 - 0.5 ** k), rtol=1e-12)
     with pytest.raises(SetDivergenceError, match="reduction wraps"):
         propagate([[0.5]], [[1.0]], box([-1e-9], [1e-9]), box([-1e-9], [1e-9]), 3, 2, growth_limit=0.5)
+
+
+def test_default_growth_limit_stops_a_boxed_rotation():
+    """A = 0.99 R(45 deg), boxed every step (2 generators kept of 3; the extra ones are zero): the box's hull
+    radius is (0.99 sqrt 2)^k, the exact set's 0.99^k sqrt 2 (k odd) or 0.99^k (k even), a ratio 8 at step 7
+    and 16 at step 8, where the default limit of 10 stops it."""
+    c = 0.99 * np.sqrt(0.5)
+    initial = Zonotope([0.0, 0.0], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    with pytest.raises(SetDivergenceError, match=r"^the enclosure grows: at step 8, output 0's hull radius 14\.8 "
+                       r"exceeds 10 times the exact set's 0\.923 \(reduction wraps; raise generators\)$"):
+        propagate([[c, -c], [c, c]], np.eye(2), initial, Zonotope([0.0, 0.0], np.zeros((2, 1))), 12, 2)
+
+
+def test_exact_radius_per_output():
+    """x+ = x / 2 + w, |x0_i| <= 1, |w_1| <= 1, |w_2| <= 2: the exact radius of output i is
+    2^-k + r_i (1 - 2^-k) / (1 - 1/2)."""
+    result = propagate(0.5 * np.eye(2), np.eye(2), box([-1.0, -1.0], [1.0, 1.0]), box([-1.0, -2.0], [1.0, 2.0]), 8, 2)
+    decay = 0.5 ** np.arange(8)[:, None]
+    np.testing.assert_allclose(result.exact_radius, decay + np.array([1.0, 2.0]) * 2 * (1 - decay), rtol=1e-12)
+
+
+def test_reduction_skips_an_empty_axis():
+    """Generators (1, 0), (0.1, 0), (0.2, 0) boxed into R^2: one box generator (1.3, 0), none along the empty
+    second axis, and R = [1, 0.1, 0.2] / 1.3."""
+    reduced = reduce(Zonotope([0.0, 0.0], [[1.0, 0.1, 0.2], [0.0, 0.0, 0.0]]), 2)
+    np.testing.assert_allclose(reduced.zonotope.generators, [[1.3], [0.0]], rtol=1e-15)
+    np.testing.assert_allclose(reduced.coefficients, [[1 / 1.3, 0.1 / 1.3, 0.2 / 1.3]], rtol=1e-15)
+
+
+def test_reduction_and_box_messages():
+    with pytest.raises(SetError, match=r"^unknown reduction method 'wobble'; known: girard, combastel, pca$"):
+        reduce(box([0.0], [1.0]), 1, "wobble")
+    with pytest.raises(SetError, match=r"^box lower bound must be finite"):
+        box([np.nan], [1.0])
