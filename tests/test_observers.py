@@ -345,20 +345,24 @@ def test_design_gains_messages_name_the_mistake():
     tau_d = np.array([40.0, 3.0, 10.0])
     with pytest.raises(ObserverError, match=r"got CheckedFunction \(pass the observer, not its .function\)"):
         design_gains(observer.function, 0.5, tau_d)
-    with pytest.raises(ObserverError, match=r"^time_constant must be positive and finite \(s\), got -0.5$"):
-        design_gains(observer, -0.5, tau_d)
+    for bad in (-0.5, np.inf, True, "0.5"):  # negative, infinite, a bool, a string
+        with pytest.raises(ObserverError, match=rf"^time_constant must be positive and finite \(s\), got {bad!r}$"):
+            design_gains(observer, bad, tau_d)
     with pytest.raises(ObserverError, match=r"^tau_d must have 3 finite entries, got \[1.0, 2.0\]$"):
         design_gains(observer, 0.5, [1, 2])
     with pytest.raises(ObserverError, match=r"^tau_d must be 3 numbers \(N, N m\), got \['a', 'b', 'c'\]$"):
         design_gains(observer, 0.5, ["a", "b", "c"])
     with pytest.raises(ObserverError, match=r"^tau_d = \[0.0, 0.0, 0.0\] is zero in every channel: the proportional "
-                                            r"observer sees no fault in any of them \(Remark 2"):
+                                            r"observer sees no fault in any of them \(Remark 2: a fault scaling "
+                                            r"tau_d,i is invisible where tau_d,i = 0\); give the nominal desired "
+                                            r"action of the run$"):
         design_gains(observer, 0.5, np.zeros(3))
 
 
 def test_unobservable_channels_check_tau_d():
     observer = actuator_observer(vehicle(OTTER), "proportional")
     assert unobservable_channels(observer, [40, 0, -1e-7]) == (1, 2)  # |tau_d,i| <= 1e-6 N
+    assert unobservable_channels(observer, [1e-6, -1e-6, 1.5e-6]) == (0, 1)  # the threshold itself is unobservable
     with pytest.raises(ObserverError, match=r"^tau_d must be 3 numbers \(N, N m\), got 'abc'$"):
         unobservable_channels(observer, "abc")
     with pytest.raises(ObserverError, match=r"^tau_d must have 3 finite entries, got \[40.0, nan, 1.0\]$"):
@@ -380,11 +384,29 @@ def test_a_positive_bias_leaves_the_lower_bound_of_the_command_alone():
     # a bias of +3 delivers u + 3: the command must keep u in [-10, 10] and u + 3 in [-10, 10], so u in [-10, 7];
     # u_d = -6 gives u* = -9, inside that range, so it is returned unchanged and delivers -6
     estimate = {"a": ActuatorFaultEstimate("a", "bias", 3.0, 0.0)}
-    u_star = corrected_commands([-6.0, 1.0], estimate, ("a", "b"), np.eye(2), np.full(2, -10.0), np.full(2, 10.0))
-    np.testing.assert_array_equal(u_star, [-9.0, 1.0])
+    # (a and b push the same force, so a command inside the bounds is kept as it is, not traded against b)
+    B, bounds = np.array([[1.0, 1.0]]), (np.full(2, -10.0), np.full(2, 10.0))
+    np.testing.assert_array_equal(corrected_commands([-6.0, 1.0], estimate, ("a", "b"), B, *bounds), [-9.0, 1.0])
     # the upper bound moves by the bias: u_d = 10 needs u* = 7, the edge, still inside
-    u_star = corrected_commands([10.0, 1.0], estimate, ("a", "b"), np.eye(2), np.full(2, -10.0), np.full(2, 10.0))
-    np.testing.assert_allclose(u_star, [7.0, 1.0], atol=1e-12)
+    np.testing.assert_array_equal(corrected_commands([10.0, 1.0], estimate, ("a", "b"), B, *bounds), [7.0, 1.0])
+    # integer bounds are bounds in the input's unit, not an integer type: u_max = 10 leaves a bias of 0.5 the bound
+    # 9.5, so u_d = 9.75 gives u* = 9.25, inside
+    half = {"a": ActuatorFaultEstimate("a", "bias", 0.5, 0.0)}
+    np.testing.assert_array_equal(corrected_commands([9.75, 1.0], half, ("a", "b"), np.eye(2), [-10, -10], [10, 10]),
+                                  [9.25, 1.0])
+
+
+def test_stopping_every_actuator_is_refused_and_exact_B_is_accepted():
+    from fractions import Fraction
+
+    stuck = {label: ActuatorFaultEstimate(label, "constant", 1.0, 0.0) for label in ("a", "b")}
+    with pytest.raises(IdentifiabilityError, match=r"^every actuator is stopped: nothing can take over$"):
+        linear_correction(stuck, ("a", "b"), np.eye(2))
+    # a stopped: its column (1, 0) is pinv([[1, 1], [1, -1]]) (1, 0) = (1/2, 1/2) of b and c; B given exactly
+    B = [[Fraction(1), Fraction(1), Fraction(1)], [Fraction(0), Fraction(1), Fraction(-1)]]
+    correction = linear_correction({"a": ActuatorFaultEstimate("a", "constant", 0.0, 0.0)}, ("a", "b", "c"), B)
+    np.testing.assert_allclose(correction.S, [[0.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.5, 0.0, 1.0]], atol=1e-15)
+    np.testing.assert_array_equal(correction.o, 0.0)
 
 
 def test_configuration_labels_and_exact_equilibrium_values():
@@ -392,7 +414,15 @@ def test_configuration_labels_and_exact_equilibrium_values():
 
     config = configuration_at(vehicle("docking_auv"), np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), np.zeros(4))
     assert config.labels == ("X", "delta_e", "delta_ru", "delta_rd")  # the model's inputs: thrust, elevator, rudders
+    assert config.groups == (("all", (0, 1, 2, 3)),)  # one group of every input (the 6-equation counting rule)
     u_e = [Fraction(1, 2), Fraction(-1, 8), Fraction(1, 16), Fraction(0)]
-    u = actuator_values(config, np.zeros(6), u_e=u_e)  # tau = tau_e: u = u_e exactly
+    tau = [Fraction(k, 3) for k in range(6)]
+    u = actuator_values(config, tau, tau_e=tau, u_e=u_e)  # tau = tau_e: u = u_e exactly, as floats
     assert u.dtype == np.float64
     np.testing.assert_array_equal(u, [0.5, -0.125, 0.0625, 0.0])
+    # 3 DOF (X, Y, N): rows Z, K, M of the 6-row B are zero
+    otter = vehicle(OTTER)
+    B3 = np.asarray(otter.B(np.zeros(3), np.zeros(3), np.zeros(2), 0.0, 0.0))
+    B6 = configuration_at(otter, np.zeros(3), np.zeros(3), np.zeros(2)).B
+    np.testing.assert_array_equal(B6[2:5], 0.0)
+    np.testing.assert_array_equal(B6[[0, 1, 5]], B3)
