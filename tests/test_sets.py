@@ -261,3 +261,21 @@ def test_reduction_and_box_messages():
         reduce(box([0.0], [1.0]), 1, "wobble")
     with pytest.raises(SetError, match=r"^box lower bound must be finite"):
         box([np.nan], [1.0])
+
+
+def test_steps_must_be_positive_and_points_conform():
+    Z = box([-1.0], [1.0])
+    for steps in (0, -1):
+        with pytest.raises(SetError, match=rf"^steps must be a positive integer, got {steps}$"):
+            propagate([[0.5]], [[1.0]], Z, Z, steps, 2)
+    with pytest.raises(SetError, match=r"^point must have shape \(1\), got \(2,\)$"):
+        Z.contains([0.0, 0.0])
+
+
+def test_segment_excludes_a_point_just_off_its_line():
+    """<0, [(1, 0)]> and (0.5, 1e-8): 1e-8 off the line, beyond the tolerance 1e-9, though within the LP
+    solver's own feasibility tolerance (1e-7): the interval hull decides."""
+    segment = Zonotope([0.0, 0.0], [[1.0], [0.0]])
+    assert not segment.contains([0.5, 1e-8])
+    assert not segment.contains([0.5, -1e-8])
+    assert segment.contains([0.5, 0.0])
