@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import casadi as ca
 import numpy as np
 import pytest
 
 from uvsym import fixed_thrusters, vectored_thrusters, vehicle
-from uvsym.errors import ArgumentError, FaultError, IdentifiabilityError, ObserverError
+from uvsym.errors import ArgumentError, ConfigurationError, FaultError, IdentifiabilityError, ObserverError
 from uvsym.faults import ActuatorFault, apply_actuator_faults
 from uvsym.observers import KINDS, actuator_observer
 from uvsym.observers.discrete import sampled_observer
@@ -85,6 +87,15 @@ def test_the_paper_proportional_observer_refuses_a_coupled_mass_matrix():
     momentum = actuator_observer(model, "proportional", "momentum")
     tau_d, K = np.array([8.0, 1.0, 2.0, 0.5, 1.0, 0.3]), np.ones(6)
     np.testing.assert_allclose(np.asarray(momentum.error_matrix(tau_d, K)), -np.diag(K * tau_d**2), atol=1e-9)
+
+
+def test_the_paper_proportional_observer_forced_on_a_coupled_mass_matrix_is_the_printed_one():
+    # R_p = -K M^-1 T_d nu (eq. 12) as printed, so L_p = -K M^-1 T_d; M^-1 and T_d do not commute for a coupled M
+    model = vehicle("docking_auv")
+    observer = actuator_observer(model, "proportional", "paper", require_assumption_1=False)
+    tau_d, K = np.array([8.0, 1.0, 2.0, 0.5, 1.0, 0.3]), np.arange(1.0, 7.0)
+    expected = -np.diag(K) @ np.linalg.inv(model.M) @ np.diag(tau_d)
+    np.testing.assert_allclose(np.asarray(observer.L(np.zeros(6), tau_d, K)), expected, rtol=1e-12, atol=1e-15)
 
 
 def test_unknown_kind_and_form_are_refused():
@@ -321,21 +332,26 @@ def test_a_model_name_or_other_object_is_refused_with_the_right_hint():
 
 def test_observer_symbols_and_entries_carry_fossens_names():
     # 6 DOF: the restoring forces g(eta) depend on roll and pitch (eta entries phi, theta), so x_dot reads eta_3, eta_4
-    from uvsym.sympy_bridge import to_sympy
+    def symbols(function):  # names of the symbols its first output depends on
+        raw = function.raw
+        return {s.name() for s in ca.symvar(raw.call(raw.sx_in())[0])}
 
     observer = actuator_observer(vehicle("docking_auv"), "bias", "momentum")
-    raw = observer.function.raw
-    x_dot = raw.call(raw.sx_in())[0]
-    names = {s.name for s in to_sympy(x_dot).free_symbols}
+    names = symbols(observer.function)
     assert {"eta_3", "eta_4"} <= names
     assert {name.rsplit("_", 1)[0] for name in names} == {"x", "eta", "nu", "tau_d", "K"}
     assert observer.L.name_in() == ["nu", "tau_d", "K"] and observer.R.name_in() == ["nu", "tau_d", "K"]
+    assert observer.error_matrix.name_in() == ["tau_d", "K"]
+    names = symbols(actuator_observer(vehicle("docking_auv"), "proportional", "momentum").error_dynamics)  # R(tau_d)
+    assert {name.rsplit("_", 1)[0] for name in names} == {"e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"}
     # a bad entry is named by its force label (X, Y, Z, K, M, N)
     zeros, ones = np.zeros(6), np.ones(6)
     with pytest.raises(ArgumentError, match=r"bias_observer: argument x entry Z is nan"):
         observer.function(np.r_[0.0, 0.0, np.nan, 0.0, 0.0, 0.0], zeros, zeros, ones, ones)
     with pytest.raises(ArgumentError, match=r"bias_observer: argument K entry M is inf"):
         observer.function(zeros, zeros, zeros, ones, np.r_[1.0, 1.0, 1.0, 1.0, np.inf, 1.0])
+    with pytest.raises(ArgumentError, match=r"bias_observer: argument tau_d entry N is nan"):
+        observer.function(zeros, zeros, zeros, np.r_[1.0, 1.0, 1.0, 1.0, 1.0, np.nan], ones)
     with pytest.raises(ArgumentError, match=r"\.L: argument K entry Y is inf"):
         observer.L(zeros, ones, np.r_[1.0, np.inf, 1.0, 1.0, 1.0, 1.0])
 
@@ -378,6 +394,9 @@ def test_stopped_actuator_is_commanded_zero_while_the_others_saturate():
     u_star = corrected_commands([3.0, 4.0, 1.0], estimate, ("a", "b", "c"), B, np.full(3, -5.0), np.full(3, 5.0))
     assert u_star[0] == 0.0  # stopped: no command at all, not the edge of its +-1e-12 band
     np.testing.assert_allclose(u_star[1:], [5.0, 2.5], atol=1e-9)
+    exact_B = [[Fraction(1), Fraction(1), Fraction(1)], [Fraction(0), Fraction(1), Fraction(-1)]]  # B given exactly
+    u_exact = corrected_commands([3.0, 4.0, 1.0], estimate, ("a", "b", "c"), exact_B, np.full(3, -5.0), np.full(3, 5.0))
+    np.testing.assert_allclose(u_exact, [0.0, 5.0, 2.5], atol=1e-9)
 
 
 def test_a_positive_bias_leaves_the_lower_bound_of_the_command_alone():
@@ -387,18 +406,28 @@ def test_a_positive_bias_leaves_the_lower_bound_of_the_command_alone():
     # (a and b push the same force, so a command inside the bounds is kept as it is, not traded against b)
     B, bounds = np.array([[1.0, 1.0]]), (np.full(2, -10.0), np.full(2, 10.0))
     np.testing.assert_array_equal(corrected_commands([-6.0, 1.0], estimate, ("a", "b"), B, *bounds), [-9.0, 1.0])
+    exact = corrected_commands([Fraction(-6), Fraction(1)], estimate, ("a", "b"), B, *bounds)  # exact u_d
+    assert exact.dtype == np.float64 and exact.tolist() == [-9.0, 1.0]
     # the upper bound moves by the bias: u_d = 10 needs u* = 7, the edge, still inside
     np.testing.assert_array_equal(corrected_commands([10.0, 1.0], estimate, ("a", "b"), B, *bounds), [7.0, 1.0])
+    # u_d = 11 needs u* = 8, beyond 7: with B = I the command stops at 7 (delivering u_max = 10) and b is untouched
+    np.testing.assert_allclose(corrected_commands([11.0, 1.0], estimate, ("a", "b"), np.eye(2), *bounds), [7.0, 1.0],
+                               atol=1e-12)
     # integer bounds are bounds in the input's unit, not an integer type: u_max = 10 leaves a bias of 0.5 the bound
-    # 9.5, so u_d = 9.75 gives u* = 9.25, inside
-    half = {"a": ActuatorFaultEstimate("a", "bias", 0.5, 0.0)}
-    np.testing.assert_array_equal(corrected_commands([9.75, 1.0], half, ("a", "b"), np.eye(2), [-10, -10], [10, 10]),
-                                  [9.25, 1.0])
+    # 9.5, so u_d = 9.75 gives u* = 9.25, inside; u_min = -10 leaves a bias of -0.5 the bound -9.5, and -9.75 gives
+    # -9.25
+    halves = {"a": ActuatorFaultEstimate("a", "bias", 0.5, 0.0), "b": ActuatorFaultEstimate("b", "bias", -0.5, 0.0)}
+    np.testing.assert_array_equal(corrected_commands([9.75, -9.75], halves, ("a", "b"), np.eye(2), [-10, -10],
+                                                     [10, 10]), [9.25, -9.25])
+
+
+def test_commands_on_their_bounds_are_kept_without_a_fault():
+    # a and b push the same force: u_d = (-10, 4) is inside [-10, 10] (a on its bound) and needs no change
+    np.testing.assert_array_equal(corrected_commands([-10.0, 4.0], {}, ("a", "b"), np.array([[1.0, 1.0]]),
+                                                     np.full(2, -10.0), np.full(2, 10.0)), [-10.0, 4.0])
 
 
 def test_stopping_every_actuator_is_refused_and_exact_B_is_accepted():
-    from fractions import Fraction
-
     stuck = {label: ActuatorFaultEstimate(label, "constant", 1.0, 0.0) for label in ("a", "b")}
     with pytest.raises(IdentifiabilityError, match=r"^every actuator is stopped: nothing can take over$"):
         linear_correction(stuck, ("a", "b"), np.eye(2))
@@ -410,8 +439,6 @@ def test_stopping_every_actuator_is_refused_and_exact_B_is_accepted():
 
 
 def test_configuration_labels_and_exact_equilibrium_values():
-    from fractions import Fraction
-
     config = configuration_at(vehicle("docking_auv"), np.zeros(6), np.array([1.5, 0, 0, 0, 0, 0]), np.zeros(4))
     assert config.labels == ("X", "delta_e", "delta_ru", "delta_rd")  # the model's inputs: thrust, elevator, rudders
     assert config.groups == (("all", (0, 1, 2, 3)),)  # one group of every input (the 6-equation counting rule)
@@ -426,3 +453,5 @@ def test_configuration_labels_and_exact_equilibrium_values():
     B6 = configuration_at(otter, np.zeros(3), np.zeros(3), np.zeros(2)).B
     np.testing.assert_array_equal(B6[2:5], 0.0)
     np.testing.assert_array_equal(B6[[0, 1, 5]], B3)
+    with pytest.raises(ConfigurationError, match=r"^docking_auv: B must be a finite k x m matrix with 1 <= k <= 6 "):
+        actuator_values(config, np.zeros(6), rows=[])  # no force rows at all
