@@ -9,7 +9,7 @@ import uvsym
 from uvsym.errors import ModelError, ObserverError
 from uvsym.observers.actuator import actuator_observer
 from uvsym.observers.base import Observer, observer
-from uvsym.observers.discrete import actuator_fault_observer, sampled_observer
+from uvsym.observers.discrete import actuator_fault_observer, gain_units, sampled_observer
 from uvsym.observers.luenberger import luenberger_observer
 from uvsym.systems import Signals, signals, system
 
@@ -119,3 +119,57 @@ def test_luenberger_rejects_bad_gains_and_discrete_plants():
         luenberger_observer(plant.discretize(0.01, "zoh"), np.ones((2, 1)), 0.01)
     with pytest.raises(ModelError):
         signals(("a", "m"), ("a", "m"))
+
+
+def test_initial_state_and_run_name_the_bad_sample():
+    obs = observer("avg", step=lambda s, y, u, p: (0.5 * s + 0.5 * y, s + u), state=signals(("a", "-")),
+                   reads_y=signals(("b", "-")), reads_u=signals(("c", "-")), publishes=signals(("a_hat", "-")),
+                   dt=0.1)
+    with pytest.raises(ObserverError, match=r"^avg: u0 must have 1 entries \(c\), got 2$"):
+        obs.initial_state([0.0], [1.0, 2.0])
+    finite_u = np.zeros((3, 1))
+    # an infinite measurement is refused even where NaN (a missing sample) is allowed
+    with pytest.raises(ObserverError, match="measurements Y finite or NaN"):
+        obs.run([[0.0], [np.inf], [1.0]], finite_u, missing_y=True)
+    # a NaN measurement is refused when none may be missing, though every input is finite
+    with pytest.raises(ObserverError, match="measurements Y finite$"):
+        obs.run([[0.0], [np.nan], [1.0]], finite_u)
+    with pytest.raises(ObserverError, match="inputs U must be finite"):
+        obs.run(np.zeros((3, 1)), [[0.0], [np.nan], [0.0]])
+
+
+def test_gain_units_per_form_and_fault_kind():
+    # by hand: momentum form k_i (1/s), times tau_d,i^2 when the fault scales the command; the paper's form
+    # divides by m_i^2 (kg^2 for N, kg^2 m^4 for N m); a two-word unit is bracketed before squaring
+    assert gain_units("proportional", "momentum", ("N", "N m")) == ("1/(s N^2)", "1/(s (N m)^2)")
+    assert gain_units("bias", "momentum", ("N", "N m")) == ("1/s", "1/s")
+    assert gain_units("proportional", "paper", ("N", "N m")) == ("kg^2/(s N^2)", "kg^2 m^4/(s (N m)^2)")
+    assert gain_units("bias", "paper", ("N", "N m")) == ("kg^2/s", "kg^2 m^4/s")
+
+
+def test_actuator_fault_observer_defaults_to_the_paper_form_and_names_its_gains():
+    obs = actuator_fault_observer(uvsym.vehicle("otter3dof"), "bias", 0.05, [1.0, 2.0, 3.0])
+    assert obs.description.endswith("(paper form), sampled every 0.05 s")
+    assert obs.params.units == ("kg^2/s", "kg^2/s", "kg^2 m^4/s")
+    with pytest.raises(ObserverError, match=r"no gain named \['K.Z'\]; known: K.X, K.Y, K.N"):
+        obs.parameters({"K.Z": 1.0})
+    # the step's symbols carry its inputs' names (as observer() names them), so printed expressions read s, y, u, p
+    assert [str(v) for v in ca.symvar(obs.step.raw.sx_in(3))] == ["p_0", "p_1", "p_2"]
+
+
+def test_sampled_observer_keeps_a_coupling_that_vanishes_for_equal_gains():
+    """x' = P (x - nu) + tau_d, f_hat = x - nu with P = [[-K1, K1 - K2], [0, -K2]]: R = nu, L = I, q = tau_d."""
+    x, eta, nu, tau_d, K = (ca.SX.sym(a, 2) for a in ("x", "eta", "nu", "tau_d", "K"))
+    P_sym = ca.vertcat(ca.horzcat(-K[0], K[0] - K[1]), ca.horzcat(0, -K[1]))
+    function = ca.Function("coupled", [x, eta, nu, tau_d, K], [ca.mtimes(P_sym, x - nu) + tau_d, x - nu],
+                           ["x", "eta", "nu", "tau_d", "K"], ["x_dot", "f_hat"])
+    dt, gains = 0.1, np.array([1.0, 3.0])
+    sampled = sampled_observer(function, dt)
+    P_exact = np.array([[-1.0, -2.0], [0.0, -3.0]])
+    np.testing.assert_array_equal(np.asarray(sampled.pieces([0, 0], [1, 1], [0, 0], gains)[0]), P_exact)
+    # one Crank-Nicolson step (module docstring) from f_hat = 0 with nu from (1, 2) to (1.5, 1), tau_d (1, -1)
+    nu0, nu1, tau = np.array([1.0, 2.0]), np.array([1.5, 1.0]), np.array([1.0, -1.0])
+    s0 = sampled.initial_state([0, 0], nu0, tau, gains)
+    _, f_hat = sampled.step(s0, [0, 0], nu1, tau, gains)
+    expected = np.linalg.solve(np.eye(2) - dt / 2 * P_exact, dt * tau - (nu1 - nu0))
+    np.testing.assert_allclose(np.asarray(f_hat).ravel(), expected, rtol=1e-14)
