@@ -134,7 +134,8 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
 
 def _fault_action(fault: ActuatorKind, T_d, tau_d) -> tuple:
     """(G, b, G is I) with ``tau = G f + b`` for the kind's ``deliver(tau_d, f) = (g0 + g1 f) tau_d + s0 + s1 f``:
-    ``G = g1 T_d + s1 I``, ``b = g0 tau_d + s0``; zero terms are left out and unit factors add no operation."""
+    ``G = g1 T_d + s1 I``, ``b = g0 tau_d + s0``; zero terms are left out and unit factors add no operation. G is
+    never empty: in every kind of KINDS the fault acts on tau (g1 or s1 is not 0)."""
     (g0, g1), (s0, s1) = fault.gain, fault.shift
     n = tau_d.numel()
 
@@ -144,7 +145,7 @@ def _fault_action(fault: ActuatorKind, T_d, tau_d) -> tuple:
 
     G = total((g1, T_d), (s1, ca.SX.eye(n)))
     b = total((g0, tau_d), (s0, ca.SX.ones(n)))
-    return (ca.SX.zeros(n, n) if G is None else G), (ca.SX.zeros(n) if b is None else b), (g1, s1) == (0.0, 1.0)
+    return G, (ca.SX.zeros(n) if b is None else b), (g1, s1) == (0.0, 1.0)
 
 
 def proportional_observer(model: Model, form: str = "paper") -> ca.Function:
