@@ -13,7 +13,7 @@ from uvsym.codegen import find_compiler
 from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
 from uvsym.errors import ObserverError, StepSizeWarning, VerificationError
-from uvsym.observers.lms import check_mu, lms_monitor, mu_bound
+from uvsym.observers.lms import check_mu, lms_monitor, lms_step, mu_bound
 from uvsym.observers.lms_supervisor import SubstitutionSupervisor, double_criterion, switch_flag
 from uvsym.systems.signals import signals
 from uvsym.verify.lms import lms_step_claim
@@ -259,3 +259,68 @@ def test_generated_c_of_the_monitor_matches_python(tmp_path):
     ObserverSet("uvsym_lms_test", "LMS monitor", exported).write(tmp_path)
     check = check_package(tmp_path, list(exported), "uvsym_lms_test")
     assert check.max_relative_difference <= 1e-12
+
+
+def test_mu_bound_names_itself_in_its_error():
+    with pytest.raises(ObserverError, match=r"^mu_bound: order M must be a positive integer, got 0$"):
+        mu_bound(0, 1.0)
+
+
+def test_the_bare_step_names_its_symbols_as_its_inputs():
+    # the symbols are what the serialized function (hashed into a C package's manifest) holds
+    f = lms_step(3)
+    assert [str(v) for v in f.mx_in()] == ["C", "U", "target", "u", "mu"] == f.name_in()
+
+
+def test_units_and_labels_of_the_monitor_follow_its_signals():
+    force = signals(("tau", "N", "thrust"), group="input")
+    obs = lms_monitor(Y, force, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1, window=3)
+    state = obs.state
+    assert state.group == "state"
+    assert dict(zip(state.names, state.units)) == {
+        "C_1": "m/N", "C_2": "m/N", "U_1": "N", "U_2": "N", "S_1": "m/N", "S_2": "m/N", "S_3": "m/N",
+        "Cf_1": "m/N", "Cf_2": "m/N", "frozen": "-", "age": "samples", "fault": "-", "count": "samples",
+        "above": "samples"}
+    assert obs.params.units == ("1/(N)^2", "(m)^2", "-")
+    assert obs.publishes.descriptions[0] == "live FIR prediction r + d"
+    assert monitor(M=1).state.units[0] == "m"  # a dimensionless input: the weights carry y's unit
+
+
+def test_supervisor_log_times_texts_and_half_set_flags():
+    obs = monitor(M=2)
+    names = obs.publishes.names
+    flags = np.zeros((5, len(names)))
+    flags[1:, names.index("frozen_y")] = 1
+    flags[2, names.index("fault_y")] = 0.5  # not above 0.5: not set
+    flags[3:, names.index("fault_y")] = 1
+    supervisor = SubstitutionSupervisor(obs)
+    decisions = [supervisor.update(np.array([0.25 * i]), {obs.name: flags[i:i + 1]}) for i in range(5)]
+    assert [d is not None for d in decisions] == [False, False, False, True, False]
+    assert [(e.t, e.sample, e.what) for e in supervisor.events] == [
+        (0.25, 1, "eps2 alarm: filter frozen"), (0.75, 3, "R alarm: sensor fault confirmed"),
+        (0.75, 3, "substitution on from the next sample")]
+    assert all(isinstance(e.t, float) for e in supervisor.events)
+
+
+def test_step_claim_reports_its_figures_method_and_counterexample():
+    u = np.array([1.0, -1.0, 1.0, -1.0])  # P_u = 1 exactly
+    refuted = lms_step_claim(0.25, 4, u, expected="refuted")  # mu M P_u = 1: the bound 1/(M P_u) = 1/4
+    assert refuted.reason == "mu M P_u = 1 >= 1"
+    assert refuted.counterexample == {"mu_M_P_u": 1.0, "bound": 0.25}
+    assert refuted.details == {"mu": 0.25, "order": 4, "input_power": 1.0, "samples": 4, "mu_M_P_u": 1.0,
+                               "bound": 0.25}
+    assert refuted.method == ("exact rational arithmetic on the samples' binary values; stability of the filter "
+                              "from the independence-theory bound (Widrow & Stearns 1985)")
+    single = lms_step_claim(0.5, 1, [2, 0])  # M = 1 is an order; P_u = (4 + 0) / 2 = 2, mu M P_u = 1
+    assert single.status == "refuted" and single.details["input_power"] == 2.0
+    tap = lms_step_claim(0.125, 1, [2, 0])  # 0.125 * 2 = 1/4
+    assert tap.status == "proved" and tap.margin == 0.75 and tap.reason == "" and tap.counterexample is None
+    with pytest.raises(VerificationError, match="input samples u must be finite"):
+        lms_step_claim(0.1, 2, [1.0, None])  # a missing sample
+
+
+def test_an_order_one_filter_is_the_scalar_lms_update():
+    # M = 1: d = c u_{k-1}, c+ = c - 2 mu (d - y) u_{k-1}; by hand from c = 0.5, u_{k-1} = 2, y = 3, mu = 0.1:
+    # d = 1, e = -2, c+ = 0.5 + 0.4 * 2 = 1.3, and the regression vector becomes [u_k]
+    C_next, U_next, d, e = (float(v) for v in lms_step(1)(0.5, 2.0, 3.0, -4.0, 0.1))
+    assert (C_next, U_next, d, e) == pytest.approx((1.3, -4.0, 1.0, -2.0), rel=1e-15)

@@ -97,7 +97,7 @@ def lms_step(order: int) -> ca.Function:
     C, U, target, u, mu = ca.MX.sym("C", M), ca.MX.sym("U", M), ca.MX.sym("target"), ca.MX.sym("u"), ca.MX.sym("mu")
     d = ca.dot(C, U)
     e = d - target
-    return ca.Function("lms_fir_step", [C, U, target, u, mu], [C - (2 * mu * e) * U, ca.vertcat(u, U[:-1]), d, e],
+    return ca.Function("lms_fir_step", [C, U, target, u, mu], [C - (2 * mu * e) * U, ca.vertcat(u, U)[:M], d, e],
                        ["C", "U", "target", "u", "mu"], ["C_next", "U_next", "d", "e"])
 
 

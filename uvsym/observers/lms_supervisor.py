@@ -116,24 +116,26 @@ class SubstitutionSupervisor:
         self.monitor, self.channel, self.period, self.correct = monitor.name, channel, monitor.dt, correct
         self.substitute_on = substitute_on
         self.events: list[Event] = []
-        self._samples, self._frozen, self._fault, self._switched = 0, 0.0, 0.0, False
+        self._samples, self._frozen, self._fault, self._switched = 0, False, False, False
 
     def update(self, t: np.ndarray, signals: dict[str, np.ndarray]):
-        """Log this chunk's freezes, confirmations and releases; a Substitution once a fault is confirmed."""
+        """Log this chunk's freezes, confirmations and releases; a Substitution once a fault is confirmed.
+
+        t (N,) s; signals[monitor] (N, n_out) its published values; a flag is set where it exceeds 0.5."""
         from uvsym.sim.run import Substitution  # sim builds on observers, not the other way round
 
-        frozen, fault, released = (signals[self.monitor][:, c] for c in self._columns)
+        frozen, fault, released = (signals[self.monitor][:, c] > 0.5 for c in self._columns)
         for i, ti in enumerate(t):
             k = self._samples + i
-            if frozen[i] > 0.5 and self._frozen < 0.5:
+            if frozen[i] and not self._frozen:
                 self.events.append(Event(float(ti), k, "eps2 alarm: filter frozen"))
-            if fault[i] > 0.5 and self._fault < 0.5:
+            if fault[i] and not self._fault:
                 self.events.append(Event(float(ti), k, "R alarm: sensor fault confirmed"))
-            if released[i] > 0.5:
+            if released[i]:
                 self.events.append(Event(float(ti), k, "no R alarm in time: disturbance, filter released"))
-            self._frozen, self._fault = frozen[i], fault[i]
+            self._frozen, self._fault = bool(frozen[i]), bool(fault[i])
         self._samples += len(t)
-        wanted = (self._fault if SWITCH_FLAGS[self.substitute_on] == "fault" else self._frozen) > 0.5
+        wanted = self._fault if SWITCH_FLAGS[self.substitute_on] == "fault" else self._frozen
         if not self.correct or wanted == self._switched:
             return None
         self._switched = wanted
