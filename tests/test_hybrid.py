@@ -152,3 +152,39 @@ def test_estimator_with_two_measured_outputs_in_subsystem_2_integrates_each_resi
     assert out[-1, obs.publishes.index("f_1_hat")] == pytest.approx(1.0, abs=2e-3)
     model = linear_error_model(dec, [[5.0]], 3.0 * np.eye(2), est)
     assert np.linalg.eigvals(model.A).real.max() < 0
+
+
+def test_fault_directions_of_the_wrong_size_are_typed_errors_naming_F():
+    A, sys3 = plant()
+    fault = signals(("f_s", "m", "fault"), group="fault")
+    with pytest.raises(ObserverError, match=r"^three: F must be a finite \(2, 1\) matrix, got \(1, 3\)$"):
+        with_sensor_fault_states(sys3, [1.0, 2.0, 3.0], fault)  # 3 entries fill no (2, q) matrix
+    with pytest.raises(ObserverError, match=r"F must be a finite \(2, 1\) matrix, got \(2, 2\)"):
+        with_sensor_fault_states(sys3, np.eye(2), fault)  # two fault columns for one named fault
+    with pytest.raises(ObserverError, match=r"F \(2, q\); got \(3, 1\), \(1, 3\)$"):
+        decouple(sys3, sys3.linearize(), z1=["x1", "x2"], w1=["y1"], F=[0.0, 2.0, 1.0])
+    # a flat F of a whole number of rows is read row by row: (0, 2) is F = [[0], [2]]
+    flat = decouple(sys3, sys3.linearize(), z1=["x1", "x2"], w1=["y1"], F=[0.0, 2.0])
+    np.testing.assert_array_equal(flat.F2, [[2.0]])
+
+
+def test_sensor_fault_states_keep_the_plant_parameters():
+    scaled = system("scaled", "x' = -a x + u, y = x", x=signals(("x", "m"), group="state"),
+                    u=signals(("u", "m/s"), group="input"), p=signals(("a", "1/s"), group="parameter"),
+                    rhs=lambda x, u, d, p: -p[0] * x + u, p0=[2.5])
+    aug = with_sensor_fault_states(scaled, [[1.0]], signals(("f_s", "m"), group="fault"))
+    np.testing.assert_array_equal(aug.p0, [2.5])
+    # at x = 1, f = 0.5, u = 0 with the default a = 2.5: x' = -2.5, f' = 0, y = 1.5
+    np.testing.assert_array_equal(np.asarray(aug.f([1.0, 0.5], [0.0], [], aug.p0)).ravel(), [-2.5, 0.0])
+    np.testing.assert_array_equal(np.asarray(aug.h([1.0, 0.5], [0.0], aug.p0)).ravel(), [1.5])
+
+
+def test_observer_groups_and_the_error_model_gain_message():
+    A, sys3 = plant()
+    dec = split(sys3)
+    obs = hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], DT, name="groups")
+    assert obs.state.group == "state" and obs.state.names == ("v_x1", "v_x2", "x3_hat")
+    with pytest.raises(ObserverError, match=r"^error model: K1 must be a finite \(2, 1\) matrix, got shape \(1, 2\)$"):
+        linear_error_model(dec, [[1.0, 2.0]], [[1.0]])
+    with pytest.raises(ObserverError, match=r"^error model: L must be a finite \(1, 1\) matrix, got shape \(2,\)$"):
+        linear_error_model(dec, [[1.0], [2.0]], [1.0, 2.0])

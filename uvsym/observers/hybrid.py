@@ -54,6 +54,13 @@ def _rational(M: np.ndarray) -> sympy.Matrix:
     return sympy.Matrix(M.shape[0], M.shape[1], [sympy.Rational(float(v)) for v in M.ravel()])
 
 
+def _with_rows(M, rows: int) -> np.ndarray:
+    """``M`` as a float matrix of ``rows`` rows (its entries in row order) when its size allows, else as given
+    (the caller's shape check then names it)."""
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    return M.reshape(rows, -1) if rows and M.size % rows == 0 else M
+
+
 def _floats(M: sympy.Matrix) -> np.ndarray:
     return np.array(M.tolist(), dtype=float).reshape(M.shape)
 
@@ -109,8 +116,8 @@ def decouple(plant: System, lin: Linearization, *, z1, w1, E=None, F=None) -> De
     """
     E = lin.E if E is None else np.atleast_2d(np.asarray(E, dtype=float))
     n, p = lin.A.shape[0], lin.C.shape[0]
-    F = np.zeros((p, 0)) if F is None else np.atleast_2d(np.asarray(F, dtype=float)).reshape(p, -1)
-    if E.shape[0] != n or not (np.all(np.isfinite(E)) and np.all(np.isfinite(F))):
+    F = np.zeros((p, 0)) if F is None else _with_rows(F, p)
+    if E.shape[0] != n or F.shape[0] != p or not (np.all(np.isfinite(E)) and np.all(np.isfinite(F))):
         raise ObserverError(f"decoupling: E must be a finite ({n}, r) matrix and F ({p}, q); got {E.shape}, "
                             f"{F.shape}")
     iz1, iw1 = _names(plant.x, z1, "z1"), _names(plant.y, w1, "w1")
@@ -287,8 +294,8 @@ def linear_error_model(dec: Decoupling, K1, L, estimator: FaultEstimator | None 
 def with_sensor_fault_states(plant: System, F, faults: Signals) -> System:
     """``plant`` with constant sensor faults as extra states: ``f' = 0``, ``y = h(x, u, p) + F f``
     (F (n_y, q)); a Luenberger observer of it is the integral adaptive fault estimator."""
-    F = np.atleast_2d(np.asarray(F, dtype=float)).reshape(plant.y.size, -1)
-    if F.shape[1] != faults.size or not np.all(np.isfinite(F)):
+    F = _with_rows(F, plant.y.size)
+    if F.shape != (plant.y.size, faults.size) or not np.all(np.isfinite(F)):
         raise ObserverError(f"{plant.name}: F must be a finite ({plant.y.size}, {faults.size}) matrix, got {F.shape}")
     n = plant.x.size
     return system(f"{plant.name}_with_faults", f"{plant.description}; sensor faults as constant states",
