@@ -254,3 +254,150 @@ def test_counterexample_summaries_say_what_fails(claims):
     assert all(c.counterexample_summary() == "" for c in claims if c.status == "proved")
     region = next(c for c in refuted if "V_dot" in c.counterexample)
     assert f"V' = {region.counterexample['V_dot']:.3g} >" in region.counterexample_summary()
+
+
+def test_counterexample_summaries_word_for_word():
+    def summary(example):
+        return Certificate("c", "s", "m", "refuted", counterexample=example).counterexample_summary()
+
+    assert summary({"eigenvalue_modulus": 1.23456, "rho": 1.0}) == \
+        "the sampled map has an eigenvalue of modulus 1.23 >= 1"
+    assert summary({"eigenvalue_real": 0.5, "gamma": 0.25}) == \
+        "a vertex's eigenvalue has real part 0.5 > -gamma = -0.25"
+    assert summary({"V_dot": 0.13066, "bound": -0.30861, "x": {"u (m/s)": 0.0791139, "r (rad/s)": -2.0}}) == \
+        "at u (m/s) = 0.0791, r (rad/s) = -2: V' = 0.131 > -0.309"
+    assert summary({"relative_difference": 0.99999}) == \
+        "the two sides differ by 1 (relative to the size of their terms) at a sampled point"
+    assert Certificate("c", "s", "m", "refuted", counterexample={"point": {"x": 1.0}}).counterexample_summary() == ""
+    assert Certificate("c", "s", "m", "proved").counterexample_summary() == ""
+
+
+def test_certificate_to_dict_names_every_field_and_drops_infinite_margins():
+    example = {"x": {"a": 1.0}}
+    certificate = Certificate("claim", "set", "method", "refuted", "proved", -2.5, 0.25, example, "why", {"boxes": 3})
+    assert certificate.to_dict() == {"claim": "claim", "set": "set", "method": "method", "status": "refuted",
+                                     "expected": "proved", "margin": -2.5, "seconds": 0.25, "counterexample": example,
+                                     "reason": "why", "details": {"boxes": 3}}
+    for margin in (float("inf"), float("-inf"), float("nan"), None):
+        assert Certificate("c", "s", "m", "proved", margin=margin).to_dict()["margin"] is None
+    assert json.loads(json.dumps(Certificate("c", "s", "m", "proved", margin=float("inf")).to_dict()))["margin"] is None
+
+
+def _still_water_loop_nu_dot(model, gain: float, nu, delivered) -> np.ndarray:
+    """nu' of ``u_d = -gain B0' nu`` at eta = 0 in still water (B0 = dtau/du at rest), ``delivered(u_d)`` the
+    actuators' output, from the model's own nu_dot: the loop rebuilt by hand."""
+    zero = np.zeros(model.dof)
+    B0 = np.asarray(model.B(zero, zero, np.zeros(model.n_inputs), 0.0, 0.0))
+    u = delivered(-gain * B0.T @ np.asarray(nu, dtype=float))
+    return np.asarray(model.nu_dot(zero, nu, u, 0.0, 0.0)).ravel()
+
+
+def test_damping_injection_loop_matches_the_loop_built_by_hand():
+    from uvsym import vehicle
+    from uvsym.faults import ActuatorFault
+    from uvsym.verify.fault_tolerant import damping_injection_loop
+
+    model = vehicle("otter3dof")
+    faults = (ActuatorFault(0, "bias", 13.0), ActuatorFault(1, "proportional", 0.8))
+    nu = np.array([0.2, -0.1, 0.05])
+    cases = {  # u* = S u_d + o undoes the estimated faults; the thrusters then add 13 N to T_L, scale T_R by 0.8
+        None: lambda u_d: np.array([u_d[0] + 13.0, 0.8 * u_d[1]]),
+        (13.0, 0.8): lambda u_d: u_d,
+        (13.5, 0.5): lambda u_d: np.array([u_d[0] - 13.5 + 13.0, 0.8 * u_d[1] / 0.5])}
+    for estimates, delivered in cases.items():
+        loop = damping_injection_loop(model, 50.0, faults, estimates, fault_time=1.0)
+        nu_dot = np.asarray(ca.Function("loop", [loop.nu], [loop.nu_dot])(nu)).ravel()
+        assert nu_dot == pytest.approx(_still_water_loop_nu_dot(model, 50.0, nu, delivered), rel=1e-12, abs=1e-12)
+    healthy = damping_injection_loop(model, 50.0)
+    assert str(healthy.nu) == "[nu_0, nu_1, nu_2]" and healthy.control == "u_d = -50 B' nu"
+    nu_dot = np.asarray(ca.Function("loop", [healthy.nu], [healthy.nu_dot])(nu)).ravel()
+    assert nu_dot == pytest.approx(_still_water_loop_nu_dot(model, 50.0, nu, lambda u_d: u_d), rel=1e-12)
+    # gamma: smallest eigenvalue of the symmetric part of D = dh/dnu at rest, here by central differences
+    step, zero = 1e-6, np.zeros(3)
+    D = np.column_stack([(np.asarray(model.h(zero, step * e)) - np.asarray(model.h(zero, -step * e))).ravel()
+                         for e in np.eye(3)]) / (2 * step)
+    assert healthy.gamma == pytest.approx(np.linalg.eigvalsh(0.5 * (D + D.T)).min(), rel=1e-5)
+    # at rest in still water the REMUS 100's fins give no lift and its thrust (n|n|) has no slope at n = 0: u_d = 0,
+    # the loop is the vehicle left alone (a current would give the fins lift, and u_d with it)
+    remus = vehicle("remus100")
+    loop = damping_injection_loop(remus, 50.0)
+    point = np.array([0.5, 0.1, -0.1, 0.05, 0.02, 0.1])
+    nu_dot = np.asarray(ca.Function("loop", [loop.nu], [loop.nu_dot])(point)).ravel()
+    alone = np.asarray(remus.nu_dot(np.zeros(6), point, np.zeros(3), 0.0, 0.0)).ravel()
+    assert nu_dot == pytest.approx(alone, rel=1e-12, abs=1e-12)
+
+
+def test_kinetic_energy_decrease_states_its_claim_and_box_and_is_refuted_without_correction():
+    from uvsym import vehicle
+    from uvsym.faults import ActuatorFault
+    from uvsym.verify.fault_tolerant import damping_injection_loop, kinetic_energy_decrease
+
+    model = vehicle("otter3dof")
+    faults = (ActuatorFault(0, "bias", 13.0), ActuatorFault(1, "proportional", 0.8))
+    loop = damping_injection_loop(model, 50.0, faults, fault_time=1.0)
+    certificate = kinetic_energy_decrease("Otter, uncorrected", loop, [3.0, 1.0, 1.0], 0.05)
+    assert certificate.expected == "proved" and certificate.status == "refuted"  # the default expectation, not met
+    # gamma = 42.65 1/s: the smallest eigenvalue of D's symmetric part (checked by differences above)
+    assert certificate.claim == "Otter, uncorrected: V = nu'M nu, V' <= -42.65 nu'nu with u_d = -50 B' nu"
+    assert certificate.set == "|u (m/s)| <= 3, |v (m/s)| <= 1, |r (rad/s)| <= 1"
+    example = certificate.counterexample
+    assert list(example["x"]) == ["u (m/s)", "v (m/s)", "r (rad/s)"]
+    nu = np.array(list(example["x"].values()))
+    nu_dot = _still_water_loop_nu_dot(model, 50.0, nu, lambda u_d: np.array([u_d[0] + 13.0, 0.8 * u_d[1]]))
+    assert 2.0 * nu @ model.M @ nu_dot > -loop.gamma * nu @ nu  # V' = 2 nu'M nu' re-checked in plain floats
+
+
+def _toy_observer(kind: str):
+    """A duck-typed actuator observer on 2 channels: A = -diag(K tau_d^2) (proportional) or -diag(K), and derived
+    error dynamics ``A e + tau_d'``: the closed form holds exactly while tau_d is constant, never while it varies."""
+    from types import SimpleNamespace
+
+    e, f, eta, nu, tau_d, tau_d_dot, K = (ca.SX.sym(v, 2) for v in ("e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"))
+    A = -ca.diag(K * tau_d**2) if kind == "proportional" else -ca.diag(K)
+    return SimpleNamespace(kind=kind, form="toy", model_name="two channels",
+                           error_matrix=ca.Function("A", [tau_d, K], [A]),
+                           error_dynamics=ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K],
+                                                      [ca.mtimes(A, e) + tau_d_dot]))
+
+
+def test_error_dynamics_claims_name_their_form_set_and_symbols():
+    from uvsym import vehicle
+    from uvsym.observers import actuator_observer
+    from uvsym.verify.observers import error_dynamics_claim
+
+    proved = error_dynamics_claim("Theorem 1", actuator_observer(vehicle("otter3dof"), "proportional", "momentum"))
+    assert_proved(proved)
+    assert proved.claim == "Theorem 1 (momentum form, otter3dof): e' = L M^-1 T_d e"
+    assert proved.set == "all e, f, eta, nu, K, tau_d constant"
+    toy = error_dynamics_claim("Toy", _toy_observer("bias"))
+    assert_proved(toy)  # the tau_d' term is gone only because tau_d is held constant
+    assert toy.claim == "Toy (toy form, two channels): e' = L M^-1 e"
+    varying = error_dynamics_claim("Toy", _toy_observer("bias"), constant_tau_d=False, expected="refuted")
+    assert_refuted(varying)
+    assert varying.claim == "Toy (toy form, two channels): e' = L M^-1 e also while tau_d varies"
+    assert varying.set == "all e, f, eta, nu, K, tau_d varying (tau_d' free)"
+    point = varying.counterexample["point"]
+    assert sorted(point) == sorted(f"{name}_{i}" for name in ("e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K")
+                                   for i in range(2))
+    assert max(abs(point["tau_d_dot_0"]), abs(point["tau_d_dot_1"])) > 0  # e' - A e = tau_d' differs from 0 there
+
+
+def test_convergence_claims_take_the_corners_of_the_desired_actions():
+    from uvsym.verify.observers import convergence_claim
+
+    # A = -diag(K tau_d^2): the slowest rate over 0.5 <= |tau_d,i| <= 2 is 3 * 0.5^2 = 0.75, so gamma 0.5 holds
+    # and gamma 1 does not (although it would at tau_d = 1)
+    proved = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 0.5)
+    assert_proved(proved)
+    assert proved.claim == "Toy (toy form, two channels): V = e'Pe decreases at rate 1"
+    assert proved.set == "0.5 <= |tau_d,i| <= 2 (N, N m), K = [3.0, 3.0]"
+    refuted = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0, expected="refuted")
+    assert_refuted(refuted)
+    assert refuted.counterexample["eigenvalue_real"] == pytest.approx(-0.75) and refuted.counterexample["gamma"] == 1.0
+    # the bias observer's A does not depend on tau_d: its set names the gains only
+    bias = convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.25)
+    assert_proved(bias)
+    assert bias.set == "K = [3.0, 0.333333]"
+    P, A = np.array(bias.details["P"]), -np.diag([3.0, 1.0 / 3.0])
+    assert np.linalg.eigvalsh(P).min() > 0 and np.linalg.eigvalsh(A.T @ P + P @ A + 0.5 * P).max() < 0
+    assert_refuted(convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.5, expected="refuted"))
