@@ -4,6 +4,7 @@ huge (1e300), zero-width and out-of-domain boxes, against mpmath at 60 digits (t
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import casadi as ca
 import numpy as np
@@ -12,7 +13,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from uvsym.errors import VerificationError
-from uvsym.verify.enclosure_check import OPERATIONS, enclosure_violations
+from uvsym.verify import enclosure_check
+from uvsym.verify.enclosure_check import BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.interval import IntervalFunction
 
 UNARY = [name for name in OPERATIONS if name not in ("add", "sub", "mul", "div", "fmin", "fmax")]
@@ -84,3 +86,42 @@ def test_large_and_infinite_exponents():
     assert time.perf_counter() - started < 1.0 and bounds.lo[0, 0] <= 0.5 ** 1e12 and bounds.hi[0, 0] == np.inf
     with pytest.raises(VerificationError, match="finite exponent"):
         IntervalFunction(ca.Function("f", [x], [ca.constpow(x, np.inf)]))([[0.5]], [[1.5]])
+
+
+def test_random_boxes_of_each_kind_have_the_ends_they_are_named_for():
+    """200 boxes per kind: finite ends in order; moderate within 50, straddle within 3 and across 0, subnormal
+    within 2.2e-308 of 0 on both sides, huge between 1e299 and 10^308.2 (some below 1e300) on both sides,
+    zero width at magnitudes from below 1e-100 to above 1e100."""
+    rng = np.random.default_rng(8)
+    ends = {kind: np.array([random_box(rng, kind) for _ in range(200)]) for kind in BOX_KINDS}
+    for kind, box in ends.items():
+        assert np.isfinite(box).all() and (box[:, 0] <= box[:, 1]).all(), kind
+    assert (np.abs(ends["moderate"]) <= 50).all() and (np.abs(ends["straddle"]) <= 3).all()
+    assert ((ends["straddle"][:, 0] < 0) & (ends["straddle"][:, 1] > 0)).any()
+    assert (np.abs(ends["subnormal"]) <= 2.2e-308).all()
+    assert ends["subnormal"].min() < 0 < ends["subnormal"].max()
+    huge = np.abs(ends["huge"])
+    assert (1e299 <= huge).all() and (huge <= 10.0 ** 308.2).all() and (huge < 1e300).any()
+    assert ends["huge"].min() < 0 < ends["huge"].max()
+    zero = ends["zero width"]
+    assert (zero[:, 0] == zero[:, 1]).all() and np.abs(zero).min() < 1e-100 and np.abs(zero).max() > 1e100
+
+
+def _fake_bounds(lo: float, hi: float):
+    """An interval function that answers [lo, hi] (defined) on every box, to test the check itself."""
+    return lambda name: lambda lower, upper: SimpleNamespace(lo=np.array([[lo]]), hi=np.array([[hi]]),
+                                                             defined=np.array([True]))
+
+
+def test_the_oracle_samples_zero_and_reports_the_exact_value_to_20_digits(monkeypatch):
+    """x^2 on [-1, 1] claimed in [1e-300, 1]: the ends give 1 and random inner points exceed 1e-300 (by far), so
+    only the point 0 is outside; exp(1) = 2.71828182845904523536... claimed in [2, 2.5]: printed to 20 digits."""
+    monkeypatch.setattr(enclosure_check, "_interval_function", _fake_bounds(1e-300, 1.0))
+    violations = enclosure_violations("sq", [(-1.0, 1.0)], np.random.default_rng(0))
+    assert len(violations) == 7  # the point 0 of the first box with each of the 7 points of the (0, 0) box
+    assert set(violations) == {"sq on [(-1.0, 1.0), (0.0, 0.0)]: 0.0 at [0.0, 0.0] outside "
+                               f"[{np.float64(1e-300)!r}, {np.float64(1.0)!r}]"}
+    monkeypatch.setattr(enclosure_check, "_interval_function", _fake_bounds(2.0, 2.5))
+    violations = enclosure_violations("exp", [(1.0, 1.0)], np.random.default_rng(0))
+    assert violations and set(violations) == {"exp on [(1.0, 1.0), (0.0, 0.0)]: 2.7182818284590452354 at "
+                                              f"[1.0, 0.0] outside [{np.float64(2.0)!r}, {np.float64(2.5)!r}]"}

@@ -213,3 +213,94 @@ def test_bad_inputs_get_typed_errors_naming_the_argument():
     for call, message in cases:
         with pytest.raises(VerificationError, match=message):
             call()
+
+
+def _failure_point(a: float, b: float, gamma: float) -> Fraction:
+    """Where ``W_i / x^2 = gamma - 2 a + 2 b x`` (for ``x' = -a x + b x^2``, ``V = x^2``) changes sign."""
+    return (2 * Fraction(a) - Fraction(gamma)) / (2 * Fraction(b))
+
+
+def test_borderline_region_cases_have_the_truth_and_the_scales_they_promise():
+    """Truth by W at the ends of each side (exact rationals for the polynomial loops, where W_i / x^2 is affine
+    in x; the double-precision definition ``2 x x' + gamma x^2`` for the others, decided with a margin of 1e-5),
+    the failure point within 1e-8..1e-1 of a box end, scales spanning 1e-170..1e160, a Taylor cube inside the box."""
+    cases = region_cases(240, seed=5)
+    functions = {"sin": math.sin, "tanh": math.tanh, "expm1": math.expm1}
+    scales = []
+    for case in cases:
+        kind = case.name.split(" #")[0]
+        ends = [(i, float(e)) for i in range(len(case.a)) for e in (case.lower[i], case.upper[i])]
+        assert all(lo < 0 < hi for lo, hi in zip(case.lower, case.upper)), case
+        assert 0 < case.rho < min(min(-case.lower), min(case.upper)), case
+        if case.g == "poly":
+            W = [2 * Fraction(e) * (-Fraction(case.a[i]) * Fraction(e) + Fraction(case.b[i]) * Fraction(e) ** 2)
+                 + Fraction(case.gamma) * Fraction(e) ** 2 for i, e in ends]
+        else:
+            W = [2 * e * (-case.a[i] * functions[case.g](e)) + case.gamma * e * e for i, e in ends]
+            assert case.b == (0.0,) * len(case.a) and all(abs(w) > 1e-7 * e * e for w, (_, e) in zip(W, ends))
+        assert case.holds == all(w <= 0 for w in W), case
+        if kind == "at_zero":  # gamma >= 2 a: W_i ~ (gamma - 2 a) x^2 + 2 b x^3 > 0 on one side of 0
+            assert case.gamma >= 2 * min(case.a) and not case.holds, case
+        elif kind == "poly":
+            for i, (a, b) in enumerate(zip(case.a, case.b)):
+                point = _failure_point(a, b, case.gamma)
+                end = Fraction(float(case.upper[i] if point > 0 else case.lower[i]))
+                assert 0.99e-8 <= abs(end / point - 1) <= 0.101, (case, i)
+                scales.append(abs(float(point)))
+    assert {"at_zero", "poly", "sin", "tanh", "expm1"} == {case.name.split(" #")[0] for case in cases}
+    assert {True, False} == {case.holds for case in cases}
+    assert 1e-170 <= min(scales) < 1e-150 and 1e140 < max(scales) <= 1e160
+
+
+def test_region_case_arguments_and_W_follow_the_loop_they_name():
+    """V = x^T x and x' = -a g(x) + b x^2 evaluated at a point; W = 2 x x' + gamma x^2 there, by hand."""
+    point = [0.3, -0.7]
+    for case in region_cases(6, seed=2):
+        V, x_dot, x, gamma, lower, upper, rho = case.arguments()
+        assert (gamma, rho) == (case.gamma, case.rho) and np.array_equal(lower, case.lower)
+        assert np.array_equal(upper, case.upper) and x.shape == (len(case.a), 1)
+        p = point[:len(case.a)]
+        g = {"poly": lambda v: v, "sin": math.sin, "tanh": math.tanh, "expm1": math.expm1}[case.g]
+        expected = [-a * g(v) + b * v * v for v, a, b in zip(p, case.a, case.b)]
+        values = ca.Function("f", [x], [V, x_dot])(p)
+        assert float(values[0]) == pytest.approx(sum(v * v for v in p), rel=1e-15)
+        assert np.asarray(values[1]).ravel() == pytest.approx(expected, rel=1e-14)
+        by_hand = sum(2 * v * e + case.gamma * v * v for v, e in zip(p, expected))
+        assert float(case.W(p)) == pytest.approx(by_hand, rel=1e-12, abs=1e-15)
+
+
+def test_borderline_linear_cases_sit_at_their_exact_spectra():
+    """Eigenvalues from the characteristic polynomial in exact rationals (sympy), not from the generator:
+    rho within 1e-6 of the spectral radius, gamma within 1e-2 of the slowest rate, and the truth of both claims."""
+    import sympy
+
+    for case in linear_cases(9, seed=5):
+        matrix = sympy.Matrix([[sympy.Rational(Fraction(float(v))) for v in row] for row in case.A])
+        roots = sympy.roots(matrix.charpoly().as_expr())
+        assert sum(roots.values()) == len(case.A) and all(root.is_rational for root in roots), case.name
+        spectral, top = max(abs(root) for root in roots), max(roots)
+        gamma, rho = sympy.Rational(Fraction(case.gamma)), sympy.Rational(Fraction(case.rho))
+        assert case.holds == bool(top < -gamma) and case.holds_discrete == bool(spectral < rho), case.name
+        assert abs(rho - spectral) <= sympy.Rational(1, 10 ** 6) * spectral if spectral else rho == sympy.Rational(1, 2)
+        margin = sympy.Rational(101, 10 ** 4)  # the largest shift, 1e-2, and the rounding of gamma to a double
+        assert abs(gamma + top) <= margin * abs(top) if top else abs(gamma) <= margin
+
+
+def test_borderline_identity_cases_are_reproducible_and_false_where_they_say():
+    """The same seed gives the same expressions; each false class differs from x where its docstring says
+    (relative error 1e-15..1e-11 at x = 1, far only beyond 1e5..1e7, in the small entry beside a large one)."""
+    cases = identity_cases(10, seed=4)
+    assert [str(c.lhs) for c in cases] == [str(c.lhs) for c in identity_cases(10, seed=4)]
+    assert [c.kind for c in cases] == ["relative", "far", "spot", "masked", "cancelling"] * 2
+    for case in cases:
+        f = ca.Function("f", case.inputs, [case.lhs, case.rhs])
+        assert case.holds == (case.kind == "cancelling")
+        if case.kind == "relative":
+            lhs, rhs = (float(v) for v in f(1.0))
+            assert rhs == 1.0 and 0.5e-15 <= lhs - 1 <= 1.1e-11
+        elif case.kind == "far":  # x (1 + c (x / T)^20), c in 1e-3..1, T in 1e5..1e7: c / T^20 from x = 1e9
+            ratio = float(f(1e9)[0]) / 1e9 - 1
+            assert 1e-3 * 1e40 <= ratio <= 1e80 and ratio * 1e-100 <= 1e-20  # (1e4 / 1e9)^20 = 1e-100
+        elif case.kind == "masked":
+            lhs, rhs = (np.asarray(v).ravel() for v in f(1.0))
+            assert lhs[0] == rhs[0] >= 1e6 and 1e-9 <= lhs[1] - rhs[1] <= 1e-3
