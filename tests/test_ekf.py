@@ -4,12 +4,14 @@ linearisation of the model on the Otter, efficiency augmentation, typed errors."
 import casadi as ca
 import numpy as np
 import pytest
-from test_ukf import P0, X0, Q, R, kalman_filter, linear_plant
+from test_ukf import P0, X0, A, B, Q, R, kalman_filter, linear_plant
 
 import uvsym
 from uvsym.errors import CovarianceError, ObserverError
 from uvsym.observers.ekf import ekf
 from uvsym.observers.kalman import efficiency_augmented, run_filter, transition, unpacked
+from uvsym.systems.signals import signals
+from uvsym.systems.system import system
 
 
 def test_ekf_is_the_kalman_filter_on_a_linear_system():
@@ -68,3 +70,22 @@ def test_bad_ekf_input_is_refused():
         ekf(linear_plant(), dt=0.0, Q=Q, R=R, P0=P0)
     with pytest.raises(ObserverError, match="sampled every"):
         ekf(linear_plant(), dt=0.2, Q=Q, R=R, P0=P0)  # the plant is discrete at 0.1 s
+
+
+def test_efficiency_augmentation_of_a_discrete_system_stays_discrete():
+    plant = linear_plant()  # x+ = A x + B u at 0.1 s
+    augmented = efficiency_augmented(plant, ("f",))
+    assert augmented.discrete and augmented.dt == 0.1 and augmented.x.group == "state"
+    assert augmented.x.descriptions[-1] == "efficiency of f (1 healthy)"
+    x = np.array([1.0, 2.0, 3.0])
+    got = np.asarray(augmented.f(np.append(x, 0.5), [4.0], [], [])).ravel()
+    np.testing.assert_allclose(got, np.append(A @ x + B[:, 0] * 2.0, 0.5), atol=1e-14)  # alpha held
+
+
+def test_filter_labels_its_state_residuals_and_diagnostics():
+    bare = system("bare", "", x=signals(("a", "m")), u=signals(("f", "N")), rhs=lambda x, u, d, p: 0.5 * x + u,
+                  dt=0.1, y=signals(("a_m", "m")), output=lambda x, u, p: x)  # groups left at "signal"
+    obs = ekf(bare, dt=0.1, Q=1.0, R=1.0, P0=1.0)
+    assert obs.state.group == "state"
+    assert obs.publishes.names == ("a_hat", "r_a_m", "loglik", "pd_margin", "skipped")
+    assert obs.publishes.descriptions[-1] == "1 where y_k had a NaN and the update was skipped"

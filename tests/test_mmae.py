@@ -116,3 +116,35 @@ def test_a_nan_measurement_leaves_the_probabilities_and_says_so():
     assert OUT[:, names.index("skipped")].tolist() == [float(k == 12) for k in range(30)]
     np.testing.assert_array_equal(S[13, -2:], S[12, -2:])  # log-probabilities carried over unchanged
     assert OUT[12, names.index("loglik_plain")] == 0.0 and np.all(np.isfinite(OUT))
+
+
+def test_log_normalised_takes_its_shift_from_every_entry():
+    v = np.array([0.0, 900.0, -3.0])  # the largest in the second place: exp(900) alone would overflow
+    got = np.asarray(ca.Function("f", [s := ca.SX.sym("v", 3)], [log_normalised(s)])(v)).ravel()
+    np.testing.assert_allclose(got, [-900.0, 0.0, -903.0], atol=1e-12)  # exp(-900) is 0 next to 1
+
+
+def test_a_model_reading_other_signals_is_named_with_both_lists():
+    plain = unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, name="plain")
+    other = unscented_filter(system("other", "", x=signals(("a", "m"), group="state"), u=signals(("f", "N")),
+                                    rhs=lambda x, u, d, p: x, dt=0.1, y=signals(("a_m", "m"), ("z_m", "-")),
+                                    output=lambda x, u, p: ca.vertcat(x, x)), dt=0.1, Q=1.0, R=R, P0=1.0)
+    with pytest.raises(ObserverError) as error:
+        mmae_bank({"plain": plain, "other": other})
+    assert str(error.value) == ("model other reads y = ('a_m', 'z_m'), the first model ('a_m', 'c_m'); "
+                                "a bank's models read the same signals")
+
+
+def test_the_bank_resets_by_default_and_labels_what_it_publishes():
+    filters = {"plain": extended_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, name="plain"),
+               "biased": unscented_filter(biased_plant(), dt=0.1, Q=Q4, R=R, P0=P04, name="biased")}
+    bank = mmae_bank(filters)
+    assert bank.description == ("MMAE bank of EKF/UKF models plain, biased (floor 0.001, federated reset), "
+                                "sampled every 0.1 s")
+    assert mmae_bank(filters, reset=False).description.endswith("(floor 0.001, no reset), sampled every 0.1 s")
+    units = dict(zip(bank.publishes.names, bank.publishes.units))
+    assert [units[n] for n in ("loglik_plain", "loglik_biased", "pd_margin", "skipped", "p_plain")] == ["-"] * 5
+    rng = np.random.default_rng(8)
+    Y, U = rng.normal(size=(15, 2)), rng.normal(size=(15, 1))
+    default, reset = (run_filter(b, Y, U)[1] for b in (bank, mmae_bank(filters, reset=True)))
+    np.testing.assert_array_equal(default, reset)

@@ -9,7 +9,7 @@ from scipy.stats import chi2, multivariate_normal
 import uvsym
 from uvsym.errors import CovarianceError, ObserverError
 from uvsym.observers.kalman import run_filter, transition, unpacked
-from uvsym.observers.ukf import passive_last, ukf, unscented_weights
+from uvsym.observers.ukf import passive_last, ukf, unscented_filter, unscented_weights
 from uvsym.systems.signals import signals
 from uvsym.systems.system import system
 
@@ -162,3 +162,13 @@ def _posterior(s, R):
     the UKF's equals the closed form ``P - P (P + R)^-1 P``."""
     P = unpacked(s[6:], 6)
     return P - P @ np.linalg.solve(P + R, P)
+
+
+def test_settings_say_whether_the_update_was_in_closed_form():
+    closed = unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0).settings["affine_closed_form"]
+    by_points = unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0,
+                                 affine_closed_form=False).settings["affine_closed_form"]
+    assert (closed, by_points) == (True, False)
+    sine = system("sine", "", x=signals(("a", "m"), group="state"), u=signals(("f", "N")),
+                  rhs=lambda x, u, d, p: x, dt=0.1, y=signals(("s", "-")), output=lambda x, u, p: ca.sin(x))
+    assert unscented_filter(sine, dt=0.1, Q=1.0, R=1.0, P0=1.0).settings["affine_closed_form"] is False
