@@ -248,9 +248,14 @@ def test_exact_radius_per_output():
     np.testing.assert_allclose(result.exact_radius, decay + np.array([1.0, 2.0]) * 2 * (1 - decay), rtol=1e-12)
 
 
-def test_reduction_skips_an_empty_axis():
+@pytest.mark.parametrize("compiled", [True, False])
+def test_reduction_skips_an_empty_axis(compiled, monkeypatch):
     """Generators (1, 0), (0.1, 0), (0.2, 0) boxed into R^2: one box generator (1.3, 0), none along the empty
-    second axis, and R = [1, 0.1, 0.2] / 1.3."""
+    second axis, and R = [1, 0.1, 0.2] / 1.3 (compiled kernel and numpy path)."""
+    from uvsym.sets import reduction
+
+    if not compiled:
+        monkeypatch.setattr(reduction, "box_reduce", lambda *args, **kwargs: None)
     reduced = reduce(Zonotope([0.0, 0.0], [[1.0, 0.1, 0.2], [0.0, 0.0, 0.0]]), 2)
     np.testing.assert_allclose(reduced.zonotope.generators, [[1.3], [0.0]], rtol=1e-15)
     np.testing.assert_allclose(reduced.coefficients, [[1 / 1.3, 0.1 / 1.3, 0.2 / 1.3]], rtol=1e-15)
@@ -279,3 +284,49 @@ def test_segment_excludes_a_point_just_off_its_line():
     assert not segment.contains([0.5, 1e-8])
     assert not segment.contains([0.5, -1e-8])
     assert segment.contains([0.5, 0.0])
+
+
+def test_pca_ties_replace_the_lower_indices():
+    """17 generators in R^2, 16 kept: count 3 of the four Girard-score-0 ones (1, 0) .. (4, 0) at indices 2 .. 5
+    (the others (1, 1), score 1); ties go to the lower index, so (1, 0), (2, 0), (3, 0) become the box (6, 0)."""
+    G = np.ones((2, 17))
+    G[:, 2:6] = [[1.0, 2.0, 3.0, 4.0], [0.0, 0.0, 0.0, 0.0]]
+    reduced = reduce(Zonotope([0.0, 0.0], G), 16, "pca").zonotope
+    expected = np.hstack([np.ones((2, 2)), [[4.0], [0.0]], np.ones((2, 11)), [[6.0], [0.0]]])
+    np.testing.assert_allclose(np.abs(reduced.generators), expected, atol=1e-12)
+
+
+def test_spectral_radius_within_1e_12_of_one_counts_as_one():
+    with pytest.raises(SetDivergenceError, match="modulus >= 1"):
+        propagate([[1.0 - 1e-12]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 5, 2)
+
+
+def test_growth_error_names_the_worst_output():
+    """Output 0 reads nothing (radius 0 = exact 0), output 1 the state (radius 1, exact 1, over the limit 0.5)."""
+    with pytest.raises(SetDivergenceError, match=r"at step 0, output 1's hull radius 1 exceeds 0\.5 times the exact"
+                       r" set's 1 "):
+        propagate(0.5 * np.eye(2), [[0.0, 0.0], [0.0, 1.0]], box([-1.0, -1.0], [1.0, 1.0]),
+                  box([-1.0, -1.0], [1.0, 1.0]), 3, 2, growth_limit=0.5)
+
+
+def test_carried_coefficients_accept_any_real_numbers():
+    from decimal import Decimal
+
+    result = propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 3, 2)
+    eta = np.full((3, 1, 1), 0.5)
+    exact = carry_coefficients(result, [[Decimal("0.25")]], eta)
+    np.testing.assert_array_equal(exact, carry_coefficients(result, [[0.25]], eta))
+
+
+def test_zonotope_map_and_box_shape_messages():
+    Z = box([-1.0, -1.0], [1.0, 1.0])
+    with pytest.raises(SetError, match=r"^zonotope generators must have shape \(any, any\), got \(2,\)$"):
+        Zonotope([0.0, 0.0], [1.0, 2.0])
+    with pytest.raises(SetError, match=r"^map matrix must have shape \(any, 2\), got \(3, 3\)$"):
+        Z.map(np.eye(3))
+    with pytest.raises(SetError, match=r"^map offset must have shape \(2\), got \(3,\)$"):
+        Z.map(np.eye(2), [1.0, 2.0, 3.0])
+    with pytest.raises(SetError, match=r"^box lower bound must have shape \(any\), got \(1, 1\)$"):
+        box([[0.0]], [[1.0]])
+    with pytest.raises(SetError, match=r"^box upper bound must have shape \(2\), got \(1,\)$"):
+        box([0.0, 0.0], [1.0])
