@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from uvsym.errors import ObserverError, SetError, UIOConditionError
-from uvsym.observers.uio import uio_conditions, uio_matrices, uio_observer
+from uvsym.errors import ObserverError, SetDivergenceError, SetError, UIOConditionError
+from uvsym.observers.uio import uio_conditions, uio_matrices, uio_observer, unobservable_modes
 from uvsym.observers.uio_bank import isolate, outside_band, residual_bands, uio_bank
 from uvsym.systems import signals
 from uvsym.testing import assert_proved, assert_refuted
@@ -70,10 +70,16 @@ def test_sampling_zero_makes_the_angle_only_observer_fail_with_its_eigenvalue():
     with pytest.raises(UIOConditionError, match="not detectable") as info:
         uio_conditions(G, [[1.0, 0.0]], D)
     assert info.value.eigenvalues and abs(info.value.eigenvalues[0] + 1) < 1e-9
-    claim = uio_existence_claim("double integrator, position only", G, [[1.0, 0.0]], D, expected="refuted")
+    h = Fraction(1, 100)  # exact sampling: T G = [[0, 0], [-b/a, 1 - b h/a]] for D = (a, b) = (h^2/2, h)
+    exact_G, exact_D = [[Fraction(1), h], [Fraction(0), Fraction(1)]], [[h * h / 2], [h]]
+    claim = uio_existence_claim("double integrator, position only", exact_G, [[1.0, 0.0]], exact_D,
+                                expected="refuted")
     assert_refuted(claim)
     assert claim.counterexample["unobservable_eigenvalue"] == -1.0
     assert claim.counterexample["eigenvector"][0] == 0.0
+    # the doubles as given: a = fl(fl(0.01^2)/2), b = 0.01, so 1 - b h/a = -1 + 1.26e-17 exactly (Fraction by
+    # hand), inside the unit circle: no exact eigenvector at -1 exists, the claim must not be refuted
+    assert uio_existence_claim("doubles", G.tolist(), [[1.0, 0.0]], D.tolist()).status != "refuted"
 
 
 def test_rank_condition_failure_names_the_ranks():
@@ -166,3 +172,98 @@ def test_bands_enclose_sampled_residuals_and_reject_bad_bounds():
         residual_bands(d, vbar, [0.1, 0.1], 10, 24)
     with pytest.raises(SetError, match="dimension 6"):
         residual_bands(d, vbar, ebar, 10, 4)
+
+
+def _small_observer(**options):
+    d = uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4])
+    groups = {"states": _group("x", 3, "state"), "outputs": _group("y", 2, "output"),
+              "inputs": _group("u", 1, "input")}
+    return d, uio_observer(d, **{**groups, **options}, dt=H)
+
+
+def test_observer_signal_names_and_description():
+    _, obs = _small_observer(name="bank_a")
+    assert obs.state.names == ("z_x0", "z_x1", "z_x2")
+    assert obs.publishes.names == ("x0_hat", "x1_hat", "x2_hat", "r_y0", "r_y1")
+    assert obs.description == ("unknown-input observer decoupling 1 direction(s): "
+                               "z+ = F z + J u + K y, xhat = z + Q y")
+
+
+def test_observer_refuses_a_bad_name_and_signals_of_the_wrong_size_word_for_word():
+    with pytest.raises(ObserverError, match=r"^observer name '2uio' must start with a letter"):
+        _small_observer(name="2uio")
+    d = uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^uio: outputs has 3 signals, the design 2$"):
+        uio_observer(d, states=_group("x", 3, "state"), outputs=_group("y", 3, "output"),
+                     inputs=_group("u", 1, "input"), dt=H)
+
+
+def test_matrix_errors_name_the_matrix():
+    with pytest.raises(ObserverError, match=r"^UIO: A must be a numeric matrix, got str$"):
+        unobservable_modes("A", C3)
+    with pytest.raises(ObserverError, match=r"^UIO: A must be square, got shape \(2, 3\)$"):
+        uio_conditions(np.ones((2, 3)), C3, D3)
+    with pytest.raises(ObserverError, match=r"^UIO: K1 must be a \(3, 2\) matrix, got shape \(3, 3\)$"):
+        uio_matrices(A3, B3, C3, D3, K1=np.zeros((3, 3)))
+
+
+def test_rank_tolerance_is_relative_to_the_largest_singular_value():
+    """A = diag(1e10, 1), C = (0, 1e-3): at lambda = 1, [A - I; C] has singular values 1e10 - 1 and 1e-3,
+    a ratio of 1e-13 < 1e-9, so the mode counts as unobservable (as does 1e10, which C never sees)."""
+    modes = unobservable_modes(np.diag([1e10, 1.0]), [[0.0, 1e-3]])
+    assert sorted(m.real for m in modes) == [1.0, 1e10]
+
+
+def test_bank_errors_name_the_matrix_or_the_actuator():
+    groups = {"states": _group("x", 3, "state"), "outputs": _group("y", 2, "output"), "dt": H}
+    with pytest.raises(ObserverError, match=r"^uio: B has 1 columns but 2 inputs are named$"):
+        uio_bank(A3, B3, C3, D3, [0.1, 0.2, 0.3], inputs=_group("u", 2, "input"), **groups)
+    with pytest.raises(ObserverError, match=r"^UIO: B must be a numeric matrix, got str$"):
+        uio_bank(A3, "B", C3, D3, [0.1, 0.2, 0.3], inputs=_group("u", 1, "input"), **groups)
+    with pytest.raises(ObserverError, match=r"^UIO: D must be a \(3, any\) matrix, got shape \(2, 1\)$"):
+        uio_bank(A3, B3, C3, [1.0, 0.0], [0.1, 0.2, 0.3], inputs=_group("u", 1, "input"), **groups)
+    # decoupling [D, B_0] = [e1, e3] from y = (x1, x2): rank(C [e1 e3]) = 1, rank([e1 e3]) = 2
+    with pytest.raises(UIOConditionError, match=r"^bank, observer decoupling u0: UIO: rank\(C D\) = 1 but "
+                                                r"rank\(D\) = 2: ") as info:
+        uio_bank(0.5 * np.eye(3), [[0.0], [0.0], [1.0]], C3, [1.0, 0.0, 0.0], [0.1, 0.2, 0.3], name="bank",
+                 inputs=_group("u", 1, "input"), **groups)
+    assert info.value.ranks == (1, 2)
+
+
+def test_bands_keep_the_reduction_maps_and_stop_a_wrapping_rotation_at_ten_times():
+    d = uio_matrices(A3, B3, np.eye(3), D3, poles=[0.2, 0.3, 0.4])
+    bands = residual_bands(d, [0.01] * 3, [0.05] * 3, 5, generators=24)
+    assert len(bands.reductions) == 4  # one coefficient map per step after the first
+    r = 0.95 * np.exp(0.3j)
+    rotation = uio_matrices(A3, B3, np.eye(3), D3, poles=[r, r.conjugate(), 0.1])
+    with pytest.raises(SetDivergenceError, match=r"exceeds 10 times the exact set's"):
+        residual_bands(rotation, [0.01] * 3, [0.05] * 3, 40, generators=6)
+
+
+def test_claim_fields_say_where_how_and_why():
+    G, D = _double_integrator()
+    d = uio_matrices(G, D, np.eye(2), D, poles=[0.5, 0.6])
+    proved = uio_existence_claim("both states", G, np.eye(2), D, K1=d.K1)
+    assert proved.set == "the matrices' double entries taken as exact rationals"
+    assert proved.method == ("exact rank (fraction elimination); T D = 0 exactly; F = T G - K1 C Schur stable by "
+                             "a discrete Lyapunov certificate (X from scipy, exact rational LDL^T)")
+    assert proved.details.keys() == {"rank_CD", "spectral_radius_F"} and proved.details["rank_CD"] == 1
+    assert proved.details["spectral_radius_F"] == pytest.approx(0.6, abs=1e-9)  # the largest pole placed
+    refuted = uio_existence_claim("C D = 0", np.eye(2) * 0.5, [[0.0, 1.0]], [[1.0], [0.0]], set_description="s",
+                                  expected="refuted")
+    assert refuted.set == "s" and refuted.counterexample == {"rank_CD": 0, "rank_D": 1}
+    # every state measured, so nothing is unobservable, but K1 = 0 leaves G1 = diag(1.5, 0) unstable
+    stuck = uio_existence_claim("no gain", np.diag([1.5, 0.5]), np.eye(2), [[0.0], [1.0]], K1=np.zeros((2, 2)),
+                                expected="inconclusive")
+    assert stuck.status == "inconclusive"
+    assert stuck.reason == "neither a certified gain nor an exact unobservable eigenvector with |lambda| >= 1 was found"
+
+
+def test_claim_takes_a_nested_list_of_doubles_exactly():
+    """D = (0.1, 0.3) as a list: in double arithmetic T D is not exactly 0; taken exactly it is, and
+    T G has the eigenvalue 0 (T projects out D) and one below 1 with K1 = 0 and C = I: proved."""
+    G, D = [[1.0, 0.01], [0.0, 1.0]], [[0.1], [0.3]]
+    listed = uio_existence_claim("listed", G, [[1.0, 0.0], [0.0, 1.0]], D, K1=np.zeros((2, 2)))
+    assert listed.status == "proved"
+    assert listed.margin == uio_existence_claim("array", np.array(G), np.eye(2), np.array(D),
+                                                K1=np.zeros((2, 2))).margin

@@ -22,7 +22,7 @@ import numpy as np
 
 from uvsym.errors import ObserverError, SetError
 from uvsym.observers.base import Observer
-from uvsym.observers.uio import UIOMatrices, uio_matrices, uio_observer
+from uvsym.observers.uio import UIOMatrices, _matrix, uio_matrices, uio_observer
 from uvsym.sets import Propagation, Zonotope, propagate
 from uvsym.sets.zonotope import finite_matrix
 from uvsym.systems.signals import Signals
@@ -44,9 +44,10 @@ def uio_bank(A, B, C, D, poles, *, states: Signals, outputs: Signals, inputs: Si
     """One discrete UIO per input i of B (n, m), decoupling ``[D B_i]``, F's eigenvalues at ``poles``.
 
     Observer i is named ``<name>_<input name>``. Raises UIOConditionError when an observer does
-    not exist (the message names the actuator), ObserverError for sizes."""
-    B = np.atleast_2d(np.asarray(B, dtype=float))
-    D = np.asarray(D, dtype=float).reshape(B.shape[0], -1)
+    not exist (the message names the actuator), ObserverError for sizes or non-numeric B, D (D (n,) is one
+    direction)."""
+    B = _matrix(B, "B")
+    D = _matrix(np.reshape(D, (-1, 1)) if np.ndim(D) == 1 else D, "D", rows=B.shape[0])
     if B.shape[1] != inputs.size:
         raise ObserverError(f"{name}: B has {B.shape[1]} columns but {inputs.size} inputs are named")
     designs, observers = [], []
