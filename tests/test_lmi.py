@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from uvsym.errors import VerificationError
-from uvsym.verify.lmi import block_lmi, dual_certificate, exact_positive_semidefinite, solve_block_lmi
+from uvsym.verify.lmi import _balance, block_lmi, dual_certificate, exact_positive_semidefinite, solve_block_lmi
 
 
 def _check_dual_numerically(problem, Z):
@@ -83,3 +83,48 @@ def test_exact_semidefinite_agrees_with_eigenvalues_on_random_rational_matrices(
 def test_mismatched_blocks_are_typed_errors_naming_the_block(omega, blocks, decay, message):
     with pytest.raises(VerificationError, match=message):
         block_lmi(omega, blocks, decay)
+
+
+def test_ragged_rows_and_a_non_finite_omega_are_named():
+    with pytest.raises(VerificationError, match=r"^block 'e1': output matrix C: rows of different lengths$"):
+        block_lmi(np.eye(2), [("e1", [[Fraction(1)], [Fraction(1), Fraction(2)]])])
+    with pytest.raises(VerificationError, match=r"^Omega must be finite"):
+        block_lmi([[np.nan]], [("e1", [[1.0]])])
+
+
+def test_dual_sdp_certificate_holds_at_the_decay_asked():
+    """Omega = [[-2, 1.5], [1.5, -2]] (eigenvalues -0.5, -3.5), nothing measured, decay 0.6 > 0.5: infeasible.
+    The block modes (-2) are faster than the decay, so only the dual SDP can certify; its Z must satisfy
+    S_i = [Omega Z + Z Omega^T + 1.2 Z]_ii >= 0, i.e. Z_12 >= (2.8 / 3) Z_ii."""
+    problem = block_lmi(np.array([[-2.0, 1.5], [1.5, -2.0]]), [("a", np.zeros((1, 1))), ("b", np.zeros((1, 1)))],
+                        0.6)
+    evidence = dual_certificate(problem)
+    assert evidence is not None and evidence["source"] == "dual SDP (cvxpy, Clarabel), rounded"
+    assert evidence["check"] == "Z >= 0, C_i Z_ii = 0, [Omega Z + Z Omega^T + 2 alpha Z]_ii >= 0 in exact rationals"
+    Z = [[Fraction(v) for v in row] for row in evidence["Z"]]
+    assert all(3 * Z[0][1] >= Fraction(28, 10) * Z[i][i] for i in range(2))
+    _check_dual_numerically(problem, evidence["Z"])
+
+
+def test_a_tiny_but_non_zero_measurement_has_no_dual_certificate():
+    """Omega = 1, C = 1e-12: the gain K = 2e12 gives 1 - K C = -1, so the LMI is feasible and, by weak
+    duality, no exact dual certificate exists, although the mode looks unobservable at the PBH tolerance."""
+    assert dual_certificate(block_lmi([[1.0]], [("e", [[1e-12]])])) is None
+
+
+def test_unroundable_unobservable_direction_is_inconclusive_with_method_and_reason():
+    """Omega = 0.5 I, C = (1, 0.1): the unseen direction (-0.1, 1) makes the LMI infeasible, but a certificate
+    needs Z = c v v^T with Z_12 / Z_22 the double -0.1 (denominator 2^55), which no rounding to denominators up
+    to 10^9 gives: neither proved nor refuted."""
+    gains, certificate = solve_block_lmi(block_lmi(0.5 * np.eye(2), [("e", [[1.0, 0.1]])]), "c",
+                                         expected="refuted")
+    assert gains is None and certificate.status == "inconclusive"
+    assert certificate.method.startswith("block LMI (1 blocks, cvxpy + Clarabel)")
+    assert certificate.reason == "neither a gain that passes the exact re-check nor a dual certificate was found"
+
+
+def test_balancing_scales_by_powers_of_two_until_the_couplings_match():
+    """Omega = [[0, 2^30], [1, 0]]: D^-1 Omega D has couplings 2^30 d1/d0 and d0/d1, equal for d0/d1 = 2^15."""
+    D = _balance(block_lmi(np.array([[0.0, 2.0 ** 30], [1.0, 0.0]]), [("a", [[0.0]]), ("b", [[0.0]])]))
+    assert D[0] / D[1] == 2.0 ** 15
+    assert all(np.log2(d) == round(np.log2(d)) for d in D)
