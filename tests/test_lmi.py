@@ -128,3 +128,12 @@ def test_balancing_scales_by_powers_of_two_until_the_couplings_match():
     D = _balance(block_lmi(np.array([[0.0, 2.0 ** 30], [1.0, 0.0]]), [("a", [[0.0]]), ("b", [[0.0]])]))
     assert D[0] / D[1] == 2.0 ** 15
     assert all(np.log2(d) == round(np.log2(d)) for d in D)
+
+
+def test_a_mode_at_the_tolerance_edge_of_the_decay_is_still_tried():
+    """Omega = [[0, 1], [0, -1e-9]], nothing measured, decay 0: modes at Re lambda >= -alpha - 1e-9 (scale 1)
+    count, the edge included. Mode 0 gives Z = e1 e1^T (S = 0); mode -1e-9 has v = (1, -1e-9), whose
+    v v^T rounds (denominator 1000) to the same e1 e1^T, so it certifies on its own as well."""
+    evidence = dual_certificate(block_lmi([[0.0, 1.0], [0.0, -1e-9]], [("e", [[0.0, 0.0]])]))
+    assert evidence["Z"] == [["1", "0"], ["0", "0"]]
+    assert sorted(m["eigenvalue"][0] for m in evidence["modes"]) == [-1e-9, 0.0]
