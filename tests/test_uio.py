@@ -267,3 +267,14 @@ def test_claim_takes_a_nested_list_of_doubles_exactly():
     assert listed.status == "proved"
     assert listed.margin == uio_existence_claim("array", np.array(G), np.eye(2), np.array(D),
                                                 K1=np.zeros((2, 2))).margin
+
+
+def test_bank_decouples_every_column_of_a_two_column_disturbance():
+    """D (4, 2) and one actuator: each observer decouples [D B_i], three directions, T [D B_i] = 0."""
+    rng = np.random.default_rng(4)
+    A, B, D = np.eye(4) * 0.9 + 0.05 * rng.normal(size=(4, 4)), rng.normal(size=(4, 1)), rng.normal(size=(4, 2))
+    bank = uio_bank(A, B, np.eye(4), D, [0.3, 0.4, 0.5, 0.6], states=_group("x", 4, "state"),
+                    outputs=_group("y", 4, "output"), inputs=_group("u", 1, "input"), dt=H)
+    (design,) = bank.designs
+    assert design.D.shape == (4, 3)
+    np.testing.assert_allclose(design.T @ np.hstack([D, B]), 0, atol=1e-12)
