@@ -270,3 +270,17 @@ def test_a_supervisor_without_a_period_is_refused_by_name():
     ctrl = state_feedback("p", [[1.0]], reads=["m"], publishes=["F"])
     with pytest.raises(SimulationError, match="a supervisor needs a positive, finite period"):
         simulate_system(first_order(0.5, 2.0), [ctrl], duration=0.5, dt=DT, x0=[1.0], supervisor=Periodless())
+
+
+def test_a_stuck_actuators_share_is_taken_over_less_what_it_still_delivers():
+    """Two thrusters on one force (B = [1, 2]), the first stuck at 0.3: for u_d = (0.5, 0.5) the force asked is
+    0.5 + 1.0 = 1.5, the stuck one gives 0.3, so the second must be commanded (1.5 - 0.3) / 2 = 0.6."""
+    from uvsym.observers.ftc import linear_correction
+    from uvsym.observers.identification import ActuatorFaultEstimate
+
+    B = np.array([[1.0, 2.0]])
+    correction = linear_correction({"T1": ActuatorFaultEstimate("T1", "constant", 0.3, 5.0)}, ("T1", "T2"), B)
+    commanded = correction.S @ np.array([0.5, 0.5]) + correction.o
+    assert commanded[1] == pytest.approx(0.6, abs=1e-12)
+    assert commanded[0] == 0.0  # its command no longer matters: it is left at 0
+    assert 0.3 * B[0, 0] + commanded[1] * B[0, 1] == pytest.approx(1.5, abs=1e-12)

@@ -33,29 +33,34 @@ class Correction:
 def linear_correction(faults: dict[str, ActuatorFaultEstimate], labels: tuple[str, ...], B: np.ndarray) -> Correction:
     """The correction as a linear map ``u* = S u_d + o`` (before bounds).
 
-    A stopped actuator's column of tau is redistributed by the pseudo-inverse of the others' B.
+    A stopped actuator i (one that delivers a constant ``c_i`` whatever its command, B (n, m) the
+    linearised ``d tau / d u``) hands the rest of its share of tau, ``B_i (u_d,i - c_i)``, to the
+    others through the pseudo-inverse of their B: what it still delivers is not asked of them again.
     """
     m = len(labels)
     S, o = np.eye(m), np.zeros(m)
     B = np.asarray(B, dtype=float)
-    stopped = []
+    stopped = {}  # actuator -> the constant it delivers
     for label, fault in faults.items():
         i = labels.index(label)
+        kind = actuator_kind(fault.kind)
         try:
-            correction = actuator_kind(fault.kind).correction(fault.value)
+            correction = kind.correction(fault.value)
         except IdentifiabilityError as exc:
             raise IdentifiabilityError(f"{label}: {exc}") from None
         if correction is None:
-            stopped.append(i)
+            stopped[i] = kind.affine(fault.value)[1]
         else:
             S[i, i] = correction[0]
             o[i] += correction[1]
-    for i in stopped:
+    for i, delivered in stopped.items():
         others = [j for j in range(m) if j not in stopped]
         if not others:
             raise IdentifiabilityError("every actuator is stopped: nothing can take over")
         S[i, :] = 0.0
-        S[others, i] += np.linalg.pinv(B[:, others]) @ B[:, i]
+        takeover = np.linalg.pinv(B[:, others]) @ B[:, i]
+        S[others, i] += takeover
+        o[others] -= takeover * delivered
     return Correction(S, o)
 
 
