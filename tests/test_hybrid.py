@@ -188,3 +188,27 @@ def test_observer_groups_and_the_error_model_gain_message():
         linear_error_model(dec, [[1.0, 2.0]], [[1.0]])
     with pytest.raises(ObserverError, match=r"^error model: L must be a finite \(1, 1\) matrix, got shape \(2,\)$"):
         linear_error_model(dec, [[1.0], [2.0]], [1.0, 2.0])
+
+
+def test_defaults_one_rk4_step_the_plant_name_and_the_observer_name_message():
+    A, sys3 = plant()
+    dec = split(sys3)
+    assert dec.plant == "three"
+    obs = hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], 0.1)
+    assert obs.name == "hybrid" and obs.description.endswith("sampled every 0.1 s (1 RK4 step(s))")
+    # one classical RK4 step of the linear observer s' = M s + c (y, u held) is the 4th-order Taylor polynomial
+    s0, y, u = np.array([0.3, -0.2, 0.5]), np.array([1.0, 2.0]), np.array([1.0])
+    # by hand from the module docstring: H = (1, 1), Tu = [[0, 0], [-1, 1]], K1 = (20, 0), L = 5, x_hat = (v1 + y1,
+    # v2 + y1, z2); v' = Tu (A11 zhat1 + B1 u) + K1 (y1 - zhat1_1), z2' = x_hat1 - z2 + 5 (y3 - z2)
+    M = np.array([[-20.0, 0.0, 0.0], [2.0, -3.0, 0.0], [1.0, 0.0, -6.0]])
+    c = np.array([0.0, 2 * y[0] - 3 * y[0] + u[0], y[0] + 5 * y[1]])
+    h = 0.1
+    # s(h) for s' = M s + c: s0 + sum_k h^k M^(k-1) (M s0 + c) / k! to 4th order (RK4 on a linear system)
+    expected, term = s0.copy(), M @ s0 + c
+    for k in range(1, 5):
+        expected = expected + h ** k * term / np.prod(range(1, k + 1))
+        term = M @ term
+    s1, _ = obs.step(s0, y, u, obs.p0)
+    np.testing.assert_allclose(np.asarray(s1).ravel(), expected, rtol=1e-13, atol=1e-13)
+    with pytest.raises(ObserverError, match="^observer name 'bad-name' must start with a letter"):
+        hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], 0.1, name="bad-name")
