@@ -16,11 +16,12 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 
 ``--results PATH`` writes (and merges into) another file than the committed results.
 
-``--sample N`` tests N mutants of each module drawn at random (seeded by the module's path), an estimate
-(``sample`` in each module's record; the others count as not checked). ``--keep FOLDER`` keeps the copy;
-``--again FOLDER`` brings the current tests there and tests again only the mutants that were not killed (the tests
-kept there only add kills, so the result is that of a full run with the current tests on the source copied then).
-``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests under the key ``before``.
+``--sample N`` tests N mutants of each module drawn at random (seeded by the module's path; ``--seed TEXT`` draws
+another sample), an estimate (``sample`` in each module's record; the others count as not checked).
+``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests there and tests again only the
+mutants that were not killed (the tests kept there only add kills, so the result is that of a full run with the
+current tests on the source copied then). ``--before --tests-at COMMIT`` records a baseline with an earlier
+commit's tests under the key ``before``.
 """
 
 from __future__ import annotations
@@ -201,6 +202,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sample", type=int, metavar="N",
                         help="test N mutants of each module drawn at random (seeded by its path): an estimate, "
                              "not a full run")
+    parser.add_argument("--seed", help="with --sample: draw another sample (seeded by this text and the module's "
+                                           "path), e.g. one no test was written against, for an unbiased estimate")
     parser.add_argument("--before", action="store_true",
                         help="record this run as the baseline (key 'before') and leave the last results as they are")
     args = parser.parse_args(argv)
@@ -235,7 +238,8 @@ def main(argv: list[str] | None = None) -> int:
                            capture_output=True, text=True)
             for module, statuses in _outcomes(scratch, modules).items():
                 pending = sorted(n for n, s in statuses.items() if s not in KILLED | {"survived"})
-                draw = random.Random(module)  # the same draw whatever other modules the run takes
+                # the same draw whatever other modules the run takes; --seed draws another, unseen sample
+                draw = random.Random(module if args.seed is None else f"{args.seed}:{module}")
                 names += sorted(draw.sample(pending, min(args.sample, len(pending))))
         run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children), *names],
                              cwd=scratch, env=env, capture_output=True, text=True)
@@ -246,8 +250,8 @@ def main(argv: list[str] | None = None) -> int:
         outcomes = _outcomes(scratch, modules)
         for module, statuses in outcomes.items():
             per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
-            per_module[module].update(sample=args.sample, run_seconds=seconds, tests_at=args.tests_at,
-                                      tests_left_out=args.without,
+            per_module[module].update(sample=args.sample, sample_seed=args.seed, run_seconds=seconds,
+                                      tests_at=args.tests_at, tests_left_out=args.without,
                                       retested=sum(n.startswith(_dotted(module)) for n in names))
             survivors += left
             justified |= excused
