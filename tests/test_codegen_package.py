@@ -307,5 +307,26 @@ def test_exported_functions_and_package_names_are_checked(tmp_path):
         write_package(tmp_path / "c", [exported], "pkg", "half")
     assert not any((tmp_path / name).exists() for name in "abc")  # refused before anything is written
     (tmp_path / "a_file").write_text("not a folder")
-    with pytest.raises(CodegenError):
+    with pytest.raises(CodegenError, match=r"^cannot write the package into \S+a_file: \S+ is a file, not a folder$"):
         write_package(tmp_path / "a_file", [exported], "pkg")
+
+
+def test_build_files_manifest_names_and_layout_follow_the_package_name(tmp_path):
+    """The module docstring's layout: a Makefile (make finds no other spelling) and a CMakeLists.txt for the
+    package's own name, the CasADi API named <name>_casadi_<function>, manifest.json with sorted keys indented by
+    two spaces (so that the same package gives the same bytes)."""
+    x = ca.SX.sym("x", 2)
+    twice = Exported(ca.Function("twice", [x], [2 * x], ["x"], ["y"]), ("x",), ("y",), "doubles x")
+    manifest = write_package(tmp_path, [twice], "pkg")
+    written = {p.name for p in tmp_path.iterdir()}
+    assert {"Makefile", "CMakeLists.txt", "manifest.json"} <= written and "makefile" not in written
+    assert {"Makefile", "CMakeLists.txt"} <= set(manifest["files"])
+    assert "libpkg.a" in (tmp_path / "Makefile").read_text()
+    assert re.search(r"(?m)^project\(pkg VERSION ", (tmp_path / "CMakeLists.txt").read_text())
+    assert "None" not in (tmp_path / "CMakeLists.txt").read_text()
+    text = (tmp_path / "manifest.json").read_text()
+    assert json.loads(text)["functions"][0]["casadi_function"] == "pkg_casadi_twice"
+    assert manifest["functions"][0]["casadi_function"] == "pkg_casadi_twice"
+    assert "int pkg_casadi_twice(" in (tmp_path / "src" / "pkg_casadi.c").read_text()  # the name the manifest gives
+    # sorted top-level keys start with "casadi" (the version); nested keys one level deeper by two more spaces
+    assert text.startswith('{\n  "casadi": "') and '\n    "PKG_OK": {\n      "meaning": ' in text
