@@ -3,6 +3,7 @@ sample periods of designed blocks, reserved names and the hints of wiring errors
 
 import math
 import re
+import time
 
 import numpy as np
 import pytest
@@ -124,3 +125,61 @@ def test_too_much_memory_or_too_many_samples_is_refused_with_both_figures(monkey
     with pytest.raises(SimulationError, match=r"^duration 1e\+13 s at step 1 s is 1e\+13 samples, more than 1e\+12 "
                                               r"\(no machine holds them\); shorten the run or lengthen the step$"):
         run.grid(1e13, 1.0)
+
+
+def test_memory_figures_are_read_in_binary_units_up_to_exbibytes(monkeypatch):
+    """5 TiB = 5 * 2**40 B asked of 3 GiB; 2048 EiB = 2**71 B is past the last unit and stays in EiB."""
+    from uvsym.sim import run
+
+    monkeypatch.setattr(run, "available_memory", lambda: 3 * 2**30)
+    with pytest.raises(SimulationError, match=r"^the log needs at least 5 TiB of memory, 3 GiB are available"):
+        run.check_memory(5 * 2**40, "the log")
+    with pytest.raises(SimulationError, match=r"^the log needs at least 2\.05e\+03 EiB of memory"):
+        run.check_memory(2**71, "the log")
+
+
+def _blow_up():
+    """q' = q^2 + u: from q(0) = 1 with u = 0, q = 1 / (1 - t) escapes to infinity at t = 1 s."""
+    from uvsym.systems import signals, system
+
+    return system("blow_up", "q' = q^2", x=signals(("q", "m"), group="state"),
+                  u=signals(("u", "m/s"), group="input"), rhs=lambda x, u, d, p: x**2 + u)
+
+
+def test_an_integrator_failure_names_the_sample_it_failed_in_and_the_solvers_reason():
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    # the escape at t = 1 s lies in the sample from 0.9 s on; CVODES gives up there (too much work)
+    with pytest.raises(SimulationError, match=r'^cvodes failed at t = 0\.9 s: .*CVode returned "CV_TOO_MUCH_WORK"'):
+        simulate_system(_blow_up(), [hold], duration=2.0, dt=0.1, x0=[1.0], method="cvodes")
+    with pytest.raises(SimulationError, match=r"^cannot build the cvodes integrator with options \{.*'bogus': 1\}: "
+                                              r"Use print_options\(\) to get a full list of options\.$"):
+        simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method="cvodes", options={"bogus": 1})
+
+
+def test_casadis_diagnostics_name_the_integrator_plant(capfd):
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    with pytest.raises(SimulationError, match="diverged"):
+        simulate_system(_blow_up(), [hold], duration=1.5, dt=0.1, x0=[1.0], method="rk")
+    assert "plant:step failed" in capfd.readouterr().err
+
+
+def test_the_build_time_is_part_of_the_calls_wall_time():
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    started = time.perf_counter()
+    result = simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method="rk")
+    assert 0.0 <= result.meta["build_s"] <= time.perf_counter() - started
+
+
+def test_a_wired_loop_refuses_a_correction_and_says_it_expects_a_substitution():
+    from uvsym.observers.ftc import Correction
+
+    class Corrects:
+        period = 0.1  # s
+
+        def update(self, t, signals):
+            return Correction(np.eye(1), np.zeros(1))
+
+    ctrl = state_feedback("ctrl", [[1.0]], reads=["q"], publishes=["u"])
+    with pytest.raises(SimulationError, match=r"^supervisor returned Correction, which this loop cannot apply; "
+                                              r"expected Substitution or None$"):
+        simulate_system(integrator(), [ctrl], duration=0.3, dt=0.1, x0=[0.0], supervisor=Corrects())
