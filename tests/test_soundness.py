@@ -11,10 +11,18 @@ from fractions import Fraction
 import casadi as ca
 import numpy as np
 import pytest
+import sympy as sp
 
 from uvsym.errors import UvsymError, VerificationError
 from uvsym.testing import assert_checked, assert_proved, assert_refuted
-from uvsym.verify import Certificate, lyapunov_decrease, prove_identity, region_decrease, synthesize_observer_gain
+from uvsym.verify import (
+    Certificate,
+    identity,
+    lyapunov_decrease,
+    prove_identity,
+    region_decrease,
+    synthesize_observer_gain,
+)
 from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
 from uvsym.verify.interval import IntervalFunction
 from uvsym.verify.lyapunov import discrete_lyapunov_decrease
@@ -304,3 +312,35 @@ def test_borderline_identity_cases_are_reproducible_and_false_where_they_say():
         elif case.kind == "masked":
             lhs, rhs = (np.asarray(v).ravel() for v in f(1.0))
             assert lhs[0] == rhs[0] >= 1e6 and 1e-9 <= lhs[1] - rhs[1] <= 1e-3
+
+
+def test_symbolic_step_limits_its_own_cpu_time_and_tells_how_each_entry_vanished(monkeypatch):
+    """``_symbolic_outcome`` (run here in-process, its CPU limit recorded rather than set): the limit is
+    ``ceil(seconds)`` beyond the CPU time already used; (x+1)^2 - x^2 - 2x - 1 vanishes by rational
+    arithmetic, sin^2 + cos^2 - 1 only by simplification, x - 1 not at all."""
+    limits, sent = [], []
+    monkeypatch.setattr(identity.resource, "setrlimit", lambda kind, pair: limits.append((kind, pair)))
+    monkeypatch.setattr(identity.time, "process_time", lambda: 100.7)
+
+    class Channel:
+        send = sent.append
+
+    x = sp.Symbol("x", real=True)
+    polynomial, trigonometric = (x + 1) ** 2 - x**2 - 2 * x - 1, sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1
+    for entries in ([polynomial], [polynomial, trigonometric], [polynomial, x - 1]):
+        identity._symbolic_outcome(entries, Channel, 2.5)
+    assert sent == ["exact", "simplify", ""]
+    assert limits == [(identity.resource.RLIMIT_CPU, (3 + 100, identity.resource.RLIM_INFINITY))] * 3
+
+
+def test_synthesis_keeps_equalities_on_P_and_names_its_claim():
+    """With P = diag(p1, p2) and Y = (y1, p1 - 2 p2) the LMI of A below is diag(2 r p1 - 2 y1, (2 r - 0.2) p2) < 0:
+    feasible for r < 0.1 (by hand), so rate 0.05 is reached with P diagonal, where the unconstrained optimum is not.
+    Without a claim the certificate says "observer error decays"."""
+    A, C = np.array([[0.0, 1.0], [-2.0, -0.1]]), np.array([[1.0, 0.0]])
+    free = synthesize_observer_gain(A, C, decay=0.05)
+    assert abs(free.P[0, 1]) > 1e-3 * np.abs(free.P).max()
+    design = synthesize_observer_gain(A, C, decay=0.05, equalities=[lambda P, Y: P[0, 1] == 0])
+    assert abs(design.P[0, 1]) <= 1e-6 * np.abs(design.P).max()
+    assert max(np.linalg.eigvals(A - design.L @ C).real) <= -0.05
+    assert design.certificate.claim == "observer error decays"
