@@ -284,3 +284,55 @@ def test_a_stuck_actuators_share_is_taken_over_less_what_it_still_delivers():
     assert commanded[1] == pytest.approx(0.6, abs=1e-12)
     assert commanded[0] == 0.0  # its command no longer matters: it is left at 0
     assert 0.3 * B[0, 0] + commanded[1] * B[0, 1] == pytest.approx(1.5, abs=1e-12)
+
+
+def test_a_chunk_of_one_sample_that_identifies_a_fault_returns_its_correction():
+    """A -4 N thruster bias found on the only sample of a chunk is corrected by adding 4 N to the command."""
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.01)
+    diagnosis.isolator = StubIsolator([{"X": ("bias", -4.0)} | {c: ("healthy", 0.0) for c in "YZKMN"}])
+    correction = diagnosis.update(T[:1], _signals(1))
+    np.testing.assert_allclose(correction.o, [4.0, 0.0, 0.0, 0.0], atol=1e-9)
+
+
+def test_decisions_on_channels_the_model_lacks_decide_no_actuator():
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.3)
+    diagnosis.isolator = StubIsolator([{"Q": ("bias", 1.0)}])
+    assert diagnosis.update(T[:3], _signals(3)) is None
+    assert diagnosis.identified == {} and diagnosis.healthy == {}
+
+
+def test_actuator_values_are_solved_on_the_decided_rows_only():
+    """Rows X, Z, K and N of B decided (Y and M not) already separate the four actuators. A bias of 0.6 N m on N
+    with K healthy: the rudders move equally (K: -b_K du_ru + b_K du_rd = 0) and N gives 2 b_N du = 0.6, so each
+    rudder has a bias of 0.3 / b_N -- the undecided Y row (where the rudders act too) takes no part."""
+    model = vehicle("docking_auv")
+    diagnosis = FaultDiagnosis(model, {"bias": (None, None)}, period=0.3)
+    decided = {"X": ("healthy", 0.0), "Z": ("healthy", 0.0), "K": ("healthy", 0.0), "N": ("bias", 0.6)}
+    diagnosis.isolator = StubIsolator([decided])
+    diagnosis.update(T[:3], _signals(3))
+    b_N = configuration_at(model, np.zeros(6), np.r_[1.5, np.zeros(5)], np.array([20.0, 0.0, 0.0, 0.0])).B[5, 2]
+    for rudder in ("delta_ru", "delta_rd"):
+        assert diagnosis.identified[rudder].kind == "bias"
+        assert diagnosis.identified[rudder].value == pytest.approx(0.3 / b_N, rel=1e-9)
+    assert diagnosis.healthy == {"X": T[2]} and "delta_e" not in diagnosis.identified
+
+
+def test_an_actuators_kind_is_read_where_its_share_of_the_channel_is_largest_not_its_authority(monkeypatch):
+    """With the lower rudder's N entry cut to 0.5, the upper rudder holds b_N / (b_N + 0.5) > 1/2 of N but only 1/2
+    of Y (where its |B| is larger): its kind is read on N (bias), the lower rudder's on Y (constant)."""
+    import dataclasses
+
+    import uvsym.observers.supervisor as supervisor
+
+    def weak_lower_rudder(model, eta, nu, u):
+        config = configuration_at(model, eta, nu, u)
+        B = np.array(config.B, dtype=float)
+        B[5, 3] = 0.5
+        return dataclasses.replace(config, B=B)
+
+    monkeypatch.setattr(supervisor, "configuration_at", weak_lower_rudder)
+    diagnosis = FaultDiagnosis(vehicle("docking_auv"), {"bias": (None, None)}, period=0.3)
+    decided = {c: ("healthy", 0.0) for c in "XZKM"} | {"Y": ("constant", 0.5), "N": ("bias", 1.0)}
+    diagnosis.isolator = StubIsolator([decided])
+    diagnosis.update(T[:3], _signals(3))
+    assert diagnosis.identified["delta_ru"].kind == "bias" and diagnosis.identified["delta_rd"].kind == "constant"
