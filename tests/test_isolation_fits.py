@@ -9,6 +9,8 @@ matrix is chosen by hand: A = -diag(K), so channel i converges at rate K_i (1/s)
 from __future__ import annotations
 
 import math
+import warnings
+from fractions import Fraction
 from types import SimpleNamespace
 
 import casadi as ca
@@ -16,7 +18,7 @@ import numpy as np
 import pytest
 
 from uvsym.errors import ObserverError
-from uvsym.observers.isolation import IsolationSettings, predicted_faults
+from uvsym.observers.isolation import IsolationSettings, Isolator, predicted_faults
 
 DT = 0.01  # s
 T = np.arange(0.0, 2.0, DT)  # s
@@ -128,3 +130,31 @@ def test_a_hidden_channel_is_cut_out_of_a_coupled_error_matrix(fit):
     f_bar, visible = predicted_faults(coupled, np.zeros(2), T, f_hat, np.ones((len(T), 2)), IsolationSettings(fit=fit))
     assert visible[:, 0].all() and not visible[:, 1].any() and np.isnan(f_bar[:, 1]).all()
     np.testing.assert_allclose(f_bar[W - 1:, 0], (1.0 + 2.0 * T + 2.0 / 5.0)[W - 1:], rtol=1e-9)
+
+
+def test_a_channel_too_slow_to_see_is_hidden_without_a_numerical_warning():
+    """At a rate of 1e-9 /s the exponential's weights are all 1 to double precision: the fit's denominator
+    W sum g^2 - (sum g)^2 is 0 and the channel is hidden (NaN), quietly, whatever numpy's error settings."""
+    f_hat = np.column_stack([np.sin(3 * T), np.cos(T)])
+    with warnings.catch_warnings(), np.errstate(all="warn"):
+        warnings.simplefilter("error")
+        f_bar, visible = predict(f_hat, K=(5.0, 1e-9))
+    assert not visible[:, 1].any() and np.isnan(f_bar[:, 1]).all()
+
+
+def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record():
+    """Chunks of 50 samples with a 10-sample window (so later updates recompute only a tail): the record's mean
+    of f_bar is, row by row, the mean of the last 10 predicted faults of the whole record (NaN before 19 rows);
+    times given as exact fractions are kept as float seconds."""
+    settings, K, window = IsolationSettings(window_s=0.1), np.array([5.0, 4.0]), 10
+    f_hat, tau_d = np.column_stack([np.sin(3 * T), np.cos(T)]), np.ones((len(T), 2))
+    isolator = Isolator({"bias": (RATES, K)}, ("X", "Y"), settings)
+    for start in range(0, len(T), 50):
+        times = [Fraction(k, 100) for k in range(start, start + 50)]
+        isolator.update(times, {"bias": f_hat[start:start + 50]}, tau_d[start:start + 50])
+    assert isolator.t.dtype == np.float64
+    f_bar, _ = predicted_faults(RATES, K, T, f_hat, tau_d, settings)
+    expected = np.full_like(f_bar, np.nan)
+    for row in range(2 * window - 2, len(T)):
+        expected[row] = f_bar[row - window + 1:row + 1].mean(axis=0)
+    np.testing.assert_allclose(isolator.mean["bias"], expected, rtol=0, atol=1e-12)
