@@ -144,7 +144,7 @@ def test_a_channel_too_slow_to_see_is_hidden_without_a_numerical_warning():
 
 def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record():
     """Chunks of 50 samples with a 10-sample window (so later updates recompute only a tail): the record's mean
-    of f_bar is, row by row, the mean of the last 10 predicted faults of the whole record (NaN before 19 rows);
+    of f_bar is, row by row, the mean of the last 10 predicted faults of the whole record (NaN in the first 18 rows);
     times given as exact fractions are kept as float seconds."""
     settings, K, window = IsolationSettings(window_s=0.1), np.array([5.0, 4.0]), 10
     f_hat, tau_d = np.column_stack([np.sin(3 * T), np.cos(T)]), np.ones((len(T), 2))
