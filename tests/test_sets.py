@@ -330,3 +330,36 @@ def test_zonotope_map_and_box_shape_messages():
         box([[0.0]], [[1.0]])
     with pytest.raises(SetError, match=r"^box upper bound must have shape \(2\), got \(1,\)$"):
         box([0.0, 0.0], [1.0])
+
+
+def test_noise_set_of_the_wrong_dimension_is_named_in_lower_case():
+    Z = box([-1.0, -1.0], [1.0, 1.0])
+    with pytest.raises(SetError, match=r"^noise set must be a Zonotope of dimension 2$"):
+        propagate(np.eye(2) * 0.5, np.eye(2), Z, box([-1.0], [1.0]), 5, 4)
+
+
+def test_reduction_within_the_order_forms_no_map_unless_asked():
+    """3 generators under an order bound of 5: nothing is reduced, R = I (3, 3) only when asked for."""
+    Z = Zonotope([0.0, 0.0], [[1.0, 0.0, 2.0], [0.0, 1.0, -1.0]])
+    assert reduce(Z, 5, coefficients=False).coefficients is None
+    np.testing.assert_array_equal(reduce(Z, 5).coefficients, np.eye(3))
+
+
+def test_centre_must_be_a_vector():
+    """A scalar or a column centre is not an (n,) vector, even when its size matches the generators' rows."""
+    with pytest.raises(SetError, match=r"^zonotope center must have shape \(any\), got \(\)$"):
+        Zonotope(1.0, [[1.0]])
+    with pytest.raises(SetError, match=r"^zonotope center must have shape \(any\), got \(2, 1\)$"):
+        Zonotope([[1.0], [2.0]], np.eye(2))
+
+
+def test_point_zonotope_slack_is_the_tolerance_whatever_the_centre():
+    """No generators: hull width 0, so a point is in when within tolerance * (1 + 0) of the centre, per
+    coordinate, at the origin as at 1e6 (1e6 + 1e-6 is 1e-6 away, 1000 times the default 1e-9)."""
+    origin = Zonotope([0.0], np.zeros((1, 0)))
+    assert origin.contains([0.5e-9]) and origin.contains([-0.5e-9])
+    assert not origin.contains([1.5e-9]) and not origin.contains([-1.5e-9])
+    assert origin.contains([1.5e-3], tolerance=2e-3) and not origin.contains([2.5e-3], tolerance=2e-3)
+    far = Zonotope([1e6], np.zeros((1, 0)))
+    assert far.contains([1e6])
+    assert not far.contains([1e6 + 1e-6]) and not far.contains([1e6 - 1e-6])
