@@ -29,6 +29,11 @@ def test_observable_pair_gets_a_gain_that_decays_faster_than_asked():
     gains, certificate = solve_block_lmi(block_lmi(A, [("e", C)], 4.0))
     assert certificate.status == "proved" and certificate.margin > 0
     assert np.linalg.eigvals(A - gains.K[0] @ C).real.max() < -4.0  # oracle: numpy eigenvalues
+    # the certificate carries the gain and the Lyapunov matrix: P > 0 and He(P (A - K C)) + 8 P < 0 numerically
+    K, P = np.array(certificate.details["K"][0]), np.array(certificate.details["P"][0])
+    assert K.shape == (2, 1) and P.shape == (2, 2) and np.linalg.eigvalsh(P).min() > 0
+    Q = P @ (A - K @ C)
+    assert np.linalg.eigvalsh(Q + Q.T + 8.0 * P).max() < 0
 
 
 def test_unobservable_unstable_mode_is_refuted_with_its_eigenvalue():
@@ -119,6 +124,7 @@ def test_unroundable_unobservable_direction_is_inconclusive_with_method_and_reas
     gains, certificate = solve_block_lmi(block_lmi(0.5 * np.eye(2), [("e", [[1.0, 0.1]])]), "c",
                                          expected="refuted")
     assert gains is None and certificate.status == "inconclusive"
+    assert certificate.expected == "refuted" and not certificate.as_expected
     assert certificate.method.startswith("block LMI (1 blocks, cvxpy + Clarabel)")
     assert certificate.reason == "neither a gain that passes the exact re-check nor a dual certificate was found"
 
