@@ -3,6 +3,7 @@ bank decoupling, zonotope bands, exact existence claims."""
 
 from __future__ import annotations
 
+import time
 from fractions import Fraction
 
 import numpy as np
@@ -278,3 +279,75 @@ def test_bank_decouples_every_column_of_a_two_column_disturbance():
     (design,) = bank.designs
     assert design.D.shape == (4, 3)
     np.testing.assert_allclose(design.T @ np.hstack([D, B]), 0, atol=1e-12)
+
+
+def test_a_placement_accurate_relative_to_a_large_plant_is_accepted():
+    """T A of norm ~1e3: placed eigenvalues are only accurate to ~1e-10 ||T A|| (backward-stable eigvals), i.e.
+    ~1e-7 absolute near poles of 1e-3; that is a placement, not a failure, within the check's 1e-6."""
+    d = uio_matrices(1000 * A3, B3, C3, D3, poles=[1e-3, -1e-3, 0.0])
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(d.F).real), [-1e-3, 0.0, 1e-3], rtol=0, atol=1e-6)
+
+
+def test_observer_starts_at_the_prior_and_names_a_wrong_state_count():
+    """xhat_0 = z_0 + Q y_0 = (prior - Q y_0) + Q y_0 = prior, whatever y_0 is."""
+    prior = [0.3, -0.2, 0.5]
+    _, obs = _small_observer(prior=prior)
+    _, out = obs.run(np.array([[1.0, 2.0], [0.5, -1.0]]), np.zeros((2, 1)))
+    np.testing.assert_allclose(out[0, :3], prior, atol=1e-12)
+    d = uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^uio: states has 2 signals, the design 3$"):
+        uio_observer(d, states=_group("x", 2, "state"), outputs=_group("y", 2, "output"),
+                     inputs=_group("u", 1, "input"), dt=H)
+
+
+def test_bank_observers_are_named_after_their_actuator():
+    B = np.array([[1.0, 0.0], [0.0, 0.0], [0.5, 1.0]])
+    bank = uio_bank(A3, B, np.eye(3), D3, [0.1, 0.2, 0.3], states=_group("x", 3, "state"),
+                    outputs=_group("y", 3, "output"), inputs=_group("u", 2, "input"), dt=H, name="bank")
+    assert tuple(obs.name for obs in bank.observers) == ("bank_u0", "bank_u1")
+
+
+def test_zero_noise_bands_are_the_initial_error_through_F_and_the_tolerance_scales_with_the_width():
+    """C = I. With vbar = 0: r_k = F^k e_0, hull +-|F^k| ebar (no reduction in 5 steps of 3 generators).
+    r_0 = e_0 + v_0: hull +-(ebar + vbar) = +-0.06, width 0.12, so tolerance 0.1 allows 0.1 * 1.12 beyond it."""
+    d = uio_matrices(A3, B3, np.eye(3), D3, poles=[0.2, 0.3, 0.4])
+    ebar = np.array([0.05, 0.02, 0.01])
+    quiet = residual_bands(d, np.zeros(3), ebar, 5, generators=24)
+    for k in range(5):
+        radius = np.abs(np.linalg.matrix_power(d.F, k)) @ ebar
+        np.testing.assert_allclose(quiet.upper[k], radius, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(quiet.lower[k], -radius, rtol=1e-12, atol=1e-15)
+    with pytest.raises(SetError, match=r"^noise bound must be non-negative, got \[0\.01, -0\.01, 0\.01\]$"):
+        residual_bands(d, [0.01, -0.01, 0.01], ebar, 10, 24)
+    bands = residual_bands(d, [0.01] * 3, [0.05] * 3, 1, generators=24)
+    np.testing.assert_allclose(bands.upper[0], [0.06] * 3, rtol=1e-12)
+    r = np.array([[0.165, 0.0, -0.165], [0.18, 0.0, 0.0], [0.0, -0.18, 0.0]])[:, :, None]
+    assert outside_band(r[:1], bands, tolerance=0.1).tolist() == [[False]]  # 0.165 < 0.06 + 0.112
+    for row in r[1:]:
+        assert outside_band(row[None], bands, tolerance=0.1).tolist() == [[True]]  # 0.18 > 0.172
+
+
+def test_residuals_that_are_not_numbers_are_a_typed_error():
+    d = uio_matrices(A3, B3, np.eye(3), D3, poles=[0.2, 0.3, 0.4])
+    bands = residual_bands(d, [0.01] * 3, [0.05] * 3, 2, generators=24)
+    with pytest.raises(SetError, match=r"^residuals must be numbers in an \(N, p\[, runs\]\) array, got \[\['a'"):
+        outside_band([["a", "b", "c"]], bands)
+    with pytest.raises(SetError, match=r"^residuals must be numbers"):
+        outside_band([[0.0, 0.0, 0.0], [0.0]], bands)
+
+
+def test_claim_margins_methods_evidence_and_time_are_stated():
+    """Proved: G1 = T G = diag(0.5, 0) (T = diag(1, 0) removes D = e2), K1 = 0, F = G1: X = diag(4/3, 1) and
+    X - F^T X F = I, smallest LDL^T pivot 1. Refuted: G = diag(2, 0.5) gives G1 = diag(2, 0), the eigenvalue 2
+    with v = e1 and C v = 0 for C = (0, 1): margin 1 - 2 = -1."""
+    before = time.perf_counter()
+    proved = uio_existence_claim("stable", np.diag([0.5, 0.5]), np.eye(2), [[0.0], [1.0]], K1=np.zeros((2, 2)))
+    elapsed = time.perf_counter() - before
+    assert proved.status == "proved" and proved.margin == pytest.approx(1.0, abs=1e-12)
+    assert 0.0 <= proved.seconds <= elapsed
+    refuted = uio_existence_claim("unstable", np.diag([2.0, 0.5]), [[0.0, 1.0]], [[0.0], [1.0]], expected="refuted")
+    assert refuted.status == "refuted" and refuted.margin == -1.0
+    assert refuted.method == "PBH test in exact rationals: G1 v = lambda v and C v = 0 for |lambda| >= 1"
+    assert refuted.counterexample == {"unobservable_eigenvalue": 2.0, "eigenvalue_modulus": 2.0, "rho": 1.0,
+                                      "eigenvector": [1.0, 0.0]}
+    assert refuted.counterexample_summary() == "the sampled map has an eigenvalue of modulus 2 >= 1"

@@ -88,8 +88,12 @@ def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, ge
 def outside_band(residuals, bands: Propagation, tolerance: float = 1e-12) -> np.ndarray:
     """(N,) or (N, runs) booleans: some entry of ``r_k`` lies outside its band's interval hull.
 
-    residuals: (N, p) or (N, p, runs), N at most the bands' length."""
-    r = np.asarray(residuals, dtype=float)
+    residuals: (N, p) or (N, p, runs), N at most the bands' length. SetError for entries that are not numbers
+    or the wrong shape. tolerance: a bound counts as exceeded only beyond ``tolerance * (1 + width)`` of its band."""
+    try:
+        r = np.asarray(residuals, dtype=float)
+    except (TypeError, ValueError):
+        raise SetError(f"residuals must be numbers in an (N, p[, runs]) array, got {residuals!r:.60}") from None
     if r.ndim not in (2, 3) or r.shape[0] > len(bands.lower) or r.shape[1] != bands.lower.shape[1]:
         raise SetError(f"residuals must be (N, {bands.lower.shape[1]}[, runs]) with N <= {len(bands.lower)}, "
                        f"got {r.shape}")
