@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from uvsym.errors import VerificationError
 from uvsym.verify import enclosure_check
+from uvsym.verify.borderline import identity_cases, region_cases
 from uvsym.verify.enclosure_check import BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.interval import IntervalFunction
 
@@ -91,12 +92,14 @@ def test_large_and_infinite_exponents():
 def test_random_boxes_of_each_kind_have_the_ends_they_are_named_for():
     """200 boxes per kind: finite ends in order; moderate within 50, straddle within 3 and across 0, subnormal
     within 2.2e-308 of 0 on both sides, huge between 1e299 and 10^308.2 (some below 1e300) on both sides,
-    zero width at magnitudes from below 1e-100 to above 1e100."""
+    zero width and any at magnitudes from below 1e-100 to above 1e100; moderate boxes of positive
+    width on both sides of 0."""
     rng = np.random.default_rng(8)
     ends = {kind: np.array([random_box(rng, kind) for _ in range(200)]) for kind in BOX_KINDS}
     for kind, box in ends.items():
         assert np.isfinite(box).all() and (box[:, 0] <= box[:, 1]).all(), kind
     assert (np.abs(ends["moderate"]) <= 50).all() and (np.abs(ends["straddle"]) <= 3).all()
+    assert ends["moderate"].min() < -25 and ends["moderate"].max() > 25 and (np.diff(ends["moderate"]) > 0).all()
     assert ((ends["straddle"][:, 0] < 0) & (ends["straddle"][:, 1] > 0)).any()
     assert (np.abs(ends["subnormal"]) <= 2.2e-308).all()
     assert ends["subnormal"].min() < 0 < ends["subnormal"].max()
@@ -105,6 +108,8 @@ def test_random_boxes_of_each_kind_have_the_ends_they_are_named_for():
     assert ends["huge"].min() < 0 < ends["huge"].max()
     zero = ends["zero width"]
     assert (zero[:, 0] == zero[:, 1]).all() and np.abs(zero).min() < 1e-100 and np.abs(zero).max() > 1e100
+    anything = np.abs(ends["any"])
+    assert anything.min() < 1e-100 and anything.max() > 1e100
 
 
 def _fake_bounds(lo: float, hi: float):
@@ -125,3 +130,26 @@ def test_the_oracle_samples_zero_and_reports_the_exact_value_to_20_digits(monkey
     violations = enclosure_violations("exp", [(1.0, 1.0)], np.random.default_rng(0))
     assert violations and set(violations) == {"exp on [(1.0, 1.0), (0.0, 0.0)]: 2.7182818284590452354 at "
                                               f"[1.0, 0.0] outside [{np.float64(2.0)!r}, {np.float64(2.5)!r}]"}
+
+
+def test_region_cases_failing_at_zero_have_boxes_at_scales_1e_minus_6_to_1e6():
+    """The at-zero cases draw scale = 10^U(-6, 6) and box ends scale * U(0.5, 2): every end's magnitude lies
+    in [5e-7, 2e6], and 100 cases reach both below 1e-5 and above 1e5."""
+    cases = [c for c in region_cases(600, seed=1) if c.name.startswith("at_zero")]
+    ends = np.abs(np.concatenate([np.concatenate([c.lower, c.upper]) for c in cases]))
+    assert len(cases) == 100 and ends.min() >= 5e-7 and ends.max() <= 2e6
+    assert ends.min() < 1e-5 and ends.max() > 1e5
+
+
+def test_true_cancelling_identities_agree_where_they_saturate():
+    """1 - tanh(y) = 2 / (exp(2 y) + 1) exactly: for y << 0 both are 2, for y >> 0 both are below 1e-17
+    (y = x + c, c in [20, 200]; x = -400, -100, 0, 50 cover both tails)."""
+    cases = [c for c in identity_cases(50, seed=2) if c.holds]
+    assert len(cases) == 10 and all(c.kind == "cancelling" for c in cases)
+    for case in cases:
+        f = ca.Function("f", case.inputs, [case.lhs, case.rhs])
+        for x in (-400.0, -100.0, 0.0, 50.0):
+            lhs, rhs = (float(v) for v in f(x))
+            assert abs(lhs - rhs) <= 1e-12 * (1 + abs(rhs)), (x, lhs, rhs)
+        lhs, rhs = (float(v) for v in f(-400.0))
+        assert lhs == rhs == 2.0
