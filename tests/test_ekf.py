@@ -89,3 +89,16 @@ def test_filter_labels_its_state_residuals_and_diagnostics():
     assert obs.state.group == "state"
     assert obs.publishes.names == ("a_hat", "r_a_m", "loglik", "pd_margin", "skipped")
     assert obs.publishes.descriptions[-1] == "1 where y_k had a NaN and the update was skipped"
+
+
+def test_efficiency_augmentation_keeps_the_input_bounds():
+    otter = uvsym.plant("otter3dof")  # thrust limits of both propellers
+    left = efficiency_augmented(otter, ("T_L",))
+    assert left.u_min.tolist() == otter.u_min.tolist() and left.u_max.tolist() == otter.u_max.tolist()
+    assert np.all(np.isfinite(left.u_min))  # real bounds, not the unbounded default
+
+
+def test_filter_describes_its_positive_definiteness_margin():
+    obs = ekf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
+    described = dict(zip(obs.publishes.names, obs.publishes.descriptions))
+    assert described["pd_margin"] == "smallest relative Cholesky pivot of the step (> 0: P.D.)"

@@ -324,3 +324,37 @@ def test_an_order_one_filter_is_the_scalar_lms_update():
     # d = 1, e = -2, c+ = 0.5 + 0.4 * 2 = 1.3, and the regression vector becomes [u_k]
     C_next, U_next, d, e = (float(v) for v in lms_step(1)(0.5, 2.0, 3.0, -4.0, 0.1))
     assert (C_next, U_next, d, e) == pytest.approx((1.3, -4.0, 1.0, -2.0), rel=1e-15)
+
+
+def test_a_zero_sample_period_is_refused_naming_it():
+    with pytest.raises(ObserverError, match=r"^lms: sample period dt must be a positive, finite number, got 0\.0$"):
+        lms_monitor(Y, U, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.0)
+
+
+def test_the_monitor_describes_its_criteria_flags_and_settings():
+    obs = lms_monitor(Y, U, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1, window=3, hold=2, confirm=4)
+    described = dict(zip(obs.publishes.names, obs.publishes.descriptions))
+    assert described["eps2_y"] == "error criterion e^2" and described["fault_y"] == "fault confirmed"
+    assert obs.description == ("LMS-FIR monitor of y: order 2, R window 3, hold 2, confirm 4 samples; "
+                               "p = (mu, eps0, r0); sampled every 0.1 s")
+
+
+def test_the_regressor_and_the_reference_are_both_inputs():
+    obs = monitor(M=2, reference=REF)
+    assert obs.reads_u.names == ("u", "r") and obs.reads_u.group == "input"
+    with pytest.raises(ObserverError, match=r"^no input named \['v'\]; known: u, r$"):
+        obs.initial_state([0.0], {"u": 0.0, "r": 0.0, "v": 1.0})
+
+
+@pytest.mark.parametrize("confirm", [0, -3, True, 2.0])
+def test_double_criterion_refuses_a_confirm_that_is_not_a_positive_integer(confirm):
+    with pytest.raises(ObserverError, match=r"^double criterion: confirm must be a positive integer \(samples\)"):
+        double_criterion(confirm)
+
+
+def test_step_claim_of_a_silent_input_has_no_bound_and_states_its_claim():
+    silent = lms_step_claim(0.1, 2, [0.0, 0.0, 0.0])  # P_u = 0: mu M P_u = 0 < 1 for any mu, no finite bound
+    assert (silent.status, silent.margin, silent.details["bound"], silent.details["input_power"]) == (
+        "proved", 1.0, None, 0.0)
+    assert silent.claim == "LMS step mu = 0.1 below the mean-square bound 1 / (M P_u)"
+    assert lms_step_claim(0.1, 2, [1.0], claim="mine").claim == "mine"

@@ -148,3 +148,19 @@ def test_the_bank_resets_by_default_and_labels_what_it_publishes():
     Y, U = rng.normal(size=(15, 2)), rng.normal(size=(15, 1))
     default, reset = (run_filter(b, Y, U)[1] for b in (bank, mmae_bank(filters, reset=True)))
     np.testing.assert_array_equal(default, reset)
+
+
+def test_a_bad_model_name_is_refused_as_a_model_name():
+    plain = extended_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, name="plain")
+    with pytest.raises(ObserverError, match=r"^model name 'no good' must start with a letter"):
+        mmae_bank({"plain": plain, "no good": plain})
+
+
+def test_the_bank_reads_inputs_and_parameters_by_name():
+    plain = extended_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, name="plain")
+    bank = mmae_bank({"plain": plain, "again": plain})
+    assert (bank.reads_u.group, bank.params.group) == ("input", "parameter")
+    with pytest.raises(ObserverError, match=r"^no parameter named \['k'\]; known: none$"):
+        bank.parameters({"k": 1.0})
+    with pytest.raises(ObserverError, match=r"^no input named \['g'\]; known: f$"):
+        bank.initial_state([0.0, 0.0], {"f": 0.0, "g": 1.0})

@@ -172,3 +172,8 @@ def test_settings_say_whether_the_update_was_in_closed_form():
     sine = system("sine", "", x=signals(("a", "m"), group="state"), u=signals(("f", "N")),
                   rhs=lambda x, u, d, p: x, dt=0.1, y=signals(("s", "-")), output=lambda x, u, p: ca.sin(x))
     assert unscented_filter(sine, dt=0.1, Q=1.0, R=1.0, P0=1.0).settings["affine_closed_form"] is False
+
+
+def test_the_default_name_is_ukf():
+    assert unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0).name == "ukf"
+    assert ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0).name == "ukf"
