@@ -361,7 +361,7 @@ def test_design_gains_messages_name_the_mistake():
     tau_d = np.array([40.0, 3.0, 10.0])
     with pytest.raises(ObserverError, match=r"got CheckedFunction \(pass the observer, not its .function\)"):
         design_gains(observer.function, 0.5, tau_d)
-    for bad in (-0.5, np.inf, True, "0.5"):  # negative, infinite, a bool, a string
+    for bad in (-0.5, 0.0, np.inf, True, "0.5"):  # negative, zero (no finite gain), infinite, a bool, a string
         with pytest.raises(ObserverError, match=rf"^time_constant must be positive and finite \(s\), got {bad!r}$"):
             design_gains(observer, bad, tau_d)
     with pytest.raises(ObserverError, match=r"^tau_d must have 3 finite entries, got \[1.0, 2.0\]$"):
@@ -397,6 +397,20 @@ def test_stopped_actuator_is_commanded_zero_while_the_others_saturate():
     exact_B = [[Fraction(1), Fraction(1), Fraction(1)], [Fraction(0), Fraction(1), Fraction(-1)]]  # B given exactly
     u_exact = corrected_commands([3.0, 4.0, 1.0], estimate, ("a", "b", "c"), exact_B, np.full(3, -5.0), np.full(3, 5.0))
     np.testing.assert_allclose(u_exact, [0.0, 5.0, 2.5], atol=1e-9)
+
+
+def test_a_stopped_actuator_is_commanded_exactly_zero_however_the_solver_rounds():
+    # B = [[0.1, 0.1, -0.1, 0.3], [0.1, 0.1, 0.2, -0.2]], a stuck at 0 with u_d,a = 4: a's column equals b's, and
+    # pinv(B_bcd) (0.1, 0.1) is e_b less its part along the null direction n = (-4, 5, 3) of B_bcd (|n|^2 = 50):
+    # (0.68, 0.4, 0.24), so u_lin = (1, 0, 5) + 4 (0.68, 0.4, 0.24) = (3.72, 1.6, 5.96) with d beyond 5. The forces
+    # B_bcd u_lin are met exactly on the line u_lin + t n; d <= 5 needs t <= -0.32 and b <= 5 needs t >= -0.32, so
+    # (b, c, d) = (5, 0, 5) is the one command in the bounds with no residual
+    B = np.array([[0.1, 0.1, -0.1, 0.3], [0.1, 0.1, 0.2, -0.2]])
+    estimate = {"a": ActuatorFaultEstimate("a", "constant", 0.0, 0.0)}
+    u_star = corrected_commands([4.0, 1.0, 0.0, 5.0], estimate, ("a", "b", "c", "d"), B, np.full(4, -5.0),
+                                np.full(4, 5.0))
+    assert u_star[0] == 0.0  # not the solver's rounding (it gave -4.4e-16 when a was kept in the least squares)
+    np.testing.assert_allclose(u_star[1:], [5.0, 0.0, 5.0], rtol=0.0, atol=1e-12)
 
 
 def test_a_positive_bias_leaves_the_lower_bound_of_the_command_alone():

@@ -68,27 +68,28 @@ def corrected_commands(u_d, faults: dict[str, ActuatorFaultEstimate], labels: tu
                        u_min, u_max) -> np.ndarray:
     """Corrected commands u* (m,) within bounds: the linear correction, then bounded least squares.
 
-    The actuators minimise ``|B_eff (u* - u_lin)|`` subject to bounds, where B_eff weights each
-    actuator by its effectiveness (the gain its fault leaves: ``f_p`` for proportional faults, 0
-    for stopped ones) -- so the excess of a saturated actuator goes to the ones that can still act
-    on the same forces. A fault's shift (a bias) also narrows the command's bounds so that the
-    command plus the shift stays within them.
+    The actuators that still act minimise ``|B_eff (u* - u_lin)|`` subject to bounds, where B_eff
+    weights each actuator by its effectiveness (the gain its fault leaves: ``f_p`` for proportional
+    faults) -- so the excess of a saturated actuator goes to the ones that can still act on the same
+    forces; a stopped actuator is commanded exactly 0. A fault's shift (a bias) also narrows the
+    command's bounds so that the command plus the shift stays within them.
     """
     u_d = np.asarray(u_d, dtype=float)
     linear = linear_correction(faults, labels, B)
     u_lin = linear.S @ u_d + linear.o
-    effectiveness = np.ones(len(labels))
+    effectiveness, acting = np.ones(len(labels)), np.ones(len(labels), dtype=bool)  # acting: not stopped
     lower, upper = np.asarray(u_min, dtype=float).copy(), np.asarray(u_max, dtype=float).copy()
     for label, fault in faults.items():
         i, kind = labels.index(label), actuator_kind(fault.kind)
         if kind.ignores_command:
-            effectiveness[i], lower[i], upper[i] = 0.0, -1e-12, 1e-12
+            acting[i] = False
         else:
             effectiveness[i], shift = kind.affine(fault.value)
             lower[i], upper[i] = max(lower[i] - shift, u_min[i]), min(upper[i] - shift, u_max[i])
-    if np.all((u_lin >= lower) & (u_lin <= upper)):
-        return u_lin
-    B_eff = np.asarray(B, dtype=float) * effectiveness
-    wanted = B_eff @ u_lin
-    solution = lsq_linear(B_eff, wanted, bounds=(lower, upper), method="bvls")
-    return solution.x
+    u_acting, lower, upper = u_lin[acting], lower[acting], upper[acting]
+    if np.all((u_acting >= lower) & (u_acting <= upper)):
+        return u_lin  # a stopped actuator's row of S is zero: commanded 0
+    B_eff = np.asarray(B, dtype=float)[:, acting] * effectiveness[acting]
+    u_star = np.zeros(len(labels))  # a stopped actuator is commanded nothing, not a rounding error of the solver
+    u_star[acting] = lsq_linear(B_eff, B_eff @ u_acting, bounds=(lower, upper), method="bvls").x
+    return u_star
