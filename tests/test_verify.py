@@ -345,6 +345,11 @@ def test_kinetic_energy_decrease_states_its_claim_and_box_and_is_refuted_without
     nu = np.array(list(example["x"].values()))
     nu_dot = _still_water_loop_nu_dot(model, 50.0, nu, lambda u_d: np.array([u_d[0] + 13.0, 0.8 * u_d[1]]))
     assert 2.0 * nu @ model.M @ nu_dot > -loop.gamma * nu @ nu  # V' = 2 nu'M nu' re-checked in plain floats
+    # the box is a box of numbers whatever their type: exact fractions, or unsigned integers (which numpy would
+    # negate modulo 256, -1 -> 255, putting the box's lower corner above 0)
+    for box in ([Fraction(3), Fraction(1), Fraction(1)], np.array([3, 1, 1], dtype=np.uint8)):
+        same = kinetic_energy_decrease("Otter, uncorrected", loop, box, 0.05)
+        assert (same.status, same.set) == ("refuted", "|u (m/s)| <= 3, |v (m/s)| <= 1, |r (rad/s)| <= 1")
 
 
 def _toy_observer(kind: str):
@@ -391,6 +396,8 @@ def test_convergence_claims_take_the_corners_of_the_desired_actions():
     assert_proved(proved)
     assert proved.claim == "Toy (toy form, two channels): V = e'Pe decreases at rate 1"
     assert proved.set == "0.5 <= |tau_d,i| <= 2 (N, N m), K = [3.0, 3.0]"
+    # tau_d,1 and tau_d,2 each at 0.5 or 2: 2 x 2 corners
+    assert proved.method == "LMI (cvxpy, Clarabel) at 4 vertices, re-checked by exact rational LDL^T"
     refuted = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0, expected="refuted")
     assert_refuted(refuted)
     assert refuted.counterexample["eigenvalue_real"] == pytest.approx(-0.75) and refuted.counterexample["gamma"] == 1.0
@@ -398,6 +405,8 @@ def test_convergence_claims_take_the_corners_of_the_desired_actions():
     bias = convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.25)
     assert_proved(bias)
     assert bias.set == "K = [3.0, 0.333333]"
+    # A = -diag(K) is one matrix whatever tau_d: one vertex, not the corners of a tau_d box that plays no part
+    assert bias.method == "LMI (cvxpy, Clarabel) at 1 vertices, re-checked by exact rational LDL^T"
     P, A = np.array(bias.details["P"]), -np.diag([3.0, 1.0 / 3.0])
     assert np.linalg.eigvalsh(P).min() > 0 and np.linalg.eigvalsh(A.T @ P + P @ A + 0.5 * P).max() < 0
     assert_refuted(convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.5, expected="refuted"))
