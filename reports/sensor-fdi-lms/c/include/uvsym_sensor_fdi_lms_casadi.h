@@ -52,7 +52,7 @@ int uvsym_sensor_fdi_lms_casadi_lms_fir_step_work_bytes(casadi_int *sz_arg, casa
 #define uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_ARG 7
 #define uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_RES 5
 #define uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_IW 0
-#define uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_W 140
+#define uvsym_sensor_fdi_lms_casadi_lms_fir_step_SZ_W 281
 void uvsym_sensor_fdi_lms_casadi__casadi_version(int* major, int* minor, int* patch);
 int uvsym_sensor_fdi_lms_casadi__casadi_int_size(void);
 int uvsym_sensor_fdi_lms_casadi__casadi_real_size(void);

@@ -1531,8 +1531,8 @@ CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_step_work_bytes(casadi_
 static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   (void)iw; (void)w; (void)mem;
   casadi_int i;
-  casadi_real *rr, *w0=w+0, w1, w3, w4, *w5=w+70;
-  const casadi_real *cr, *cs, *wr0, *wr2, *wr6;
+  casadi_real *rr, *w0=w+0, w1, *w2=w+70, w3, w4, *w5=w+140, *w6=w+210;
+  const casadi_real *cr, *cs, *wr0, *wr2;
   /* #0: @0 = input[0][0] */
   wr0 = arg[0] ? arg[0] : casadi_zeros;
   /* #1: @1 = input[4][0] */
@@ -1557,12 +1557,14 @@ static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   casadi_copy(w0, 70, res[0]);
   /* #11: @1 = input[3][0] */
   w1 = arg[3] ? arg[3][0] : 0;
-  /* #12: output[1][0] = @1 */
-  if (res[1]) res[1][0] = w1;
-  /* #13: @6 = @2[:69] */
-  wr6 = wr2+0;
-  /* #14: output[1][1] = @6 */
-  if (res[1]) casadi_copy(wr6, 69, res[1]+1);
+  /* #12: @6 = vertcat(@1, @2) */
+  rr=w6;
+  *rr++ = w1;
+  for (i=0, cs=wr2; i<70; ++i) *rr++ = *cs++;
+  /* #13: @2 = @6[:70] */
+  for (rr=w2, cs=w6+0; cs!=w6+70; cs+=1) *rr++ = *cs;
+  /* #14: output[1][0] = @2 */
+  casadi_copy(w2, 70, res[1]);
   /* #15: output[2][0] = @3 */
   if (res[2]) res[2][0] = w3;
   /* #16: output[3][0] = @4 */
@@ -1645,7 +1647,7 @@ CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step_work(casadi_in
   if (sz_arg) *sz_arg = 7;
   if (sz_res) *sz_res = 5;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 140;
+  if (sz_w) *sz_w = 281;
   return 0;
 }
 
@@ -1653,7 +1655,7 @@ CASADI_SYMBOL_EXPORT int uvsym_sensor_fdi_lms_casadi_lms_fir_step_work_bytes(cas
   if (sz_arg) *sz_arg = 7*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 5*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 140*sizeof(casadi_real);
+  if (sz_w) *sz_w = 281*sizeof(casadi_real);
   return 0;
 }
 
