@@ -169,6 +169,8 @@ def test_bands_enclose_sampled_residuals_and_reject_bad_bounds():
         residual_bands(d, [0.01, np.inf, 0.01], ebar, 10, 24)
     with pytest.raises(SetError, match="non-negative"):
         residual_bands(d, [0.01, -0.01, 0.01], ebar, 10, 24)
+    with pytest.raises(SetError, match=r"^initial error bound must be non-negative, got \[0.05, -0.05, 0.05\]$"):
+        residual_bands(d, vbar, [0.05, -0.05, 0.05], 10, 24)
     with pytest.raises(SetError, match="initial error bound"):
         residual_bands(d, vbar, [0.1, 0.1], 10, 24)
     with pytest.raises(SetError, match="dimension 6"):
