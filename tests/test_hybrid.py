@@ -122,7 +122,8 @@ def test_bad_decouplings_and_gains_are_typed_errors():
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y1"], E=[[0.0], [0.0], [1.0]])
     with pytest.raises(ObserverError, match="rank\\(C D\\) = 0 but rank\\(D\\) = 1"):
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y1"], E=[[0.0], [1.0], [0.0]])
-    with pytest.raises(ObserverError, match="w1 read subsystem-2 states"):
+    with pytest.raises(ObserverError, match="^decoupling: outputs w1 read subsystem-2 states; the split must follow "
+                                            "C's blocks$"):
         decouple(sys3, lin, z1=["x1", "x2"], w1=["y3"])
     dec = split(sys3)
     with pytest.raises(ObserverError, match="K1 must be a finite \\(2, 1\\)"):
@@ -184,6 +185,9 @@ def test_observer_groups_and_the_error_model_gain_message():
     dec = split(sys3)
     obs = hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], DT, name="groups")
     assert obs.state.group == "state" and obs.state.names == ("v_x1", "v_x2", "x3_hat")
+    # the observer has no parameters: one value is one too many, and the message names the observer
+    with pytest.raises(ObserverError, match=r"^groups: parameters must have 0 entries \(\), got 1$"):
+        obs.parameters([1.0])
     with pytest.raises(ObserverError, match=r"^error model: K1 must be a finite \(2, 1\) matrix, got shape \(1, 2\)$"):
         linear_error_model(dec, [[1.0, 2.0]], [[1.0]])
     with pytest.raises(ObserverError, match=r"^error model: L must be a finite \(1, 1\) matrix, got shape \(2,\)$"):

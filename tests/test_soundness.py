@@ -210,7 +210,7 @@ def test_bad_inputs_get_typed_errors_naming_the_argument():
         (lambda: prove_identity("c", x * p, x, [x], "s"), "p"),
         (lambda: prove_identity("c", x, x, [x[0] + 1], "s"), "symbols only"),
         (lambda: prove_identity("c", x, x, [x], "s", box=([0, np.nan], [1, 1])), "box"),
-        (lambda: synthesize_observer_gain([[np.nan]], [[1.0]], 1.0), "A"),
+        (lambda: synthesize_observer_gain([[np.nan]], [[1.0]], 1.0), "^A has entries that are not finite"),
         (lambda: synthesize_observer_gain(np.eye(2), np.ones((1, 3)), 1.0), "columns"),
         (lambda: synthesize_observer_gain(-np.eye(2), np.ones((1, 2)), np.nan), "decay"),
         (lambda: synthesize_observer_gain(-np.eye(2), np.ones((1, 2)), -0.5), "decay must be a finite rate >= 0"),
