@@ -158,3 +158,13 @@ def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record(
     for row in range(2 * window - 2, len(T)):
         expected[row] = f_bar[row - window + 1:row + 1].mean(axis=0)
     np.testing.assert_allclose(isolator.mean["bias"], expected, rtol=0, atol=1e-12)
+
+
+def test_gains_given_as_exact_fractions_predict_the_fault_like_floats():
+    """K = (5, 4) as Fractions is read as float gains: the exponential fit still recovers f = (13, -2) exactly."""
+    f, C, a = np.array([13.0, -2.0]), np.array([13.0, 5.0]), np.array([5.0, 4.0])
+    f_hat = f - C * np.exp(-np.outer(T, a))
+    tau_d = np.ones((len(T), 2))
+    f_bar, visible = predicted_faults(RATES, (Fraction(5), Fraction(4)), T, f_hat, tau_d, IsolationSettings())
+    assert visible.all()
+    np.testing.assert_allclose(f_bar[W - 1:], np.tile(f, (len(T) - W + 1, 1)), rtol=0, atol=1e-9)

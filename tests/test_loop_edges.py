@@ -11,7 +11,7 @@ from problems import DT, double_integrator, first_order, integrator
 
 from uvsym.errors import FaultError, SimulationError, WiringError
 from uvsym.faults import ActuatorFault, Profile, SensorFault
-from uvsym.sim import block, interconnect, lqr, open_loop, pid, simulate_system, state_feedback
+from uvsym.sim import Substitution, block, interconnect, lqr, open_loop, pid, simulate_system, state_feedback
 
 
 def test_a_fault_starts_at_the_sample_that_rounds_just_below_its_onset():
@@ -183,3 +183,46 @@ def test_a_wired_loop_refuses_a_correction_and_says_it_expects_a_substitution():
     with pytest.raises(SimulationError, match=r"^supervisor returned Correction, which this loop cannot apply; "
                                               r"expected Substitution or None$"):
         simulate_system(integrator(), [ctrl], duration=0.3, dt=0.1, x0=[0.0], supervisor=Corrects())
+
+
+def test_a_supervisor_switching_on_a_channel_the_loop_lacks_is_refused_with_the_loops_channels():
+    class Unknown:
+        period = 0.1  # s
+
+        def update(self, t, signals):
+            return Substitution({"psi"})
+
+    est = block("est", step=lambda s, r: (s, r), reads="q.raw", publishes="q_hat")
+    ctrl = state_feedback("ctrl", [[1.0]], reads=["q"], publishes=["u"])
+    with pytest.raises(SimulationError, match=r"^supervisor switched on substitution channels \['psi'\] the loop does "
+                                              r"not have; channels: q$"):
+        simulate_system(integrator(), [est, ctrl], duration=0.3, dt=0.1, x0=[0.0], substitutions={"q": "q_hat"},
+                        supervisor=Unknown())
+
+
+def test_check_chunk_guards_the_finite_rows_by_their_times_and_names_the_first_non_finite_row():
+    """Rows 0-1 finite, row 2 NaN in x.b, row 3 inf in x.a: the guard sees rows 0-1 with their times (column 0 of
+    W), the error names x.b at sample start + 2 = 8, i.e. t = 8 * 0.5 s = 4 s."""
+    from types import SimpleNamespace
+
+    from uvsym.sim.run import check_chunk
+
+    loop = SimpleNamespace(dt=0.5, signals={"x": (slice(0, 2), ("a", "b"), ("m", "m"))})
+    W_rows = np.array([[3.0, 9.0], [3.5, 9.0], [4.0, 9.0], [4.5, 9.0]])
+    rows = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, np.nan], [np.inf, 3.0]])
+    seen = []
+    with pytest.raises(SimulationError, match=r"^the loop diverged: x\.b \(nan\) is non-finite from t = 4 s \(rk\)"):
+        check_chunk(loop, "rk", 6, W_rows, rows, np.zeros(1), guard=lambda t, out: seen.append((t.copy(), out)))
+    np.testing.assert_array_equal(seen[0][0], [3.0, 3.5])
+    np.testing.assert_array_equal(seen[0][1], rows[:2])
+    with pytest.raises(SimulationError, match=r"x\.a \(inf\) is non-finite from t = 3\.5 s"):  # a single bad row
+        check_chunk(loop, "rk", 6, W_rows[:2], np.array([[0.0, 0.0], [np.inf, 0.0]]), np.zeros(1))
+
+
+@pytest.mark.parametrize("duration, dt", [(0.0, 0.1), (1.0, 0.0)])
+def test_a_zero_duration_or_step_is_refused_by_name(duration, dt):
+    from uvsym.sim import run
+
+    with pytest.raises(SimulationError, match=rf"^duration and step must be positive and finite, got {duration} s "
+                                              rf"and {dt} s$"):
+        run.grid(duration, dt)

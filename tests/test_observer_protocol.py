@@ -173,3 +173,15 @@ def test_sampled_observer_keeps_a_coupling_that_vanishes_for_equal_gains():
     _, f_hat = sampled.step(s0, [0, 0], nu1, tau, gains)
     expected = np.linalg.solve(np.eye(2) - dt / 2 * P_exact, dt * tau - (nu1 - nu0))
     np.testing.assert_allclose(np.asarray(f_hat).ravel(), expected, rtol=1e-14)
+
+
+def test_actuator_fault_observer_refuses_gains_that_are_not_numbers_and_reads_desired_forces():
+    model = uvsym.vehicle("otter3dof")
+    with pytest.raises(ObserverError, match=r"^bias observer: the gains K must be 3 positive finite numbers "
+                                            r".*got 'fast'$"):
+        actuator_fault_observer(model, "bias", 0.05, "fast")
+    with pytest.raises(ObserverError, match=r"got \[1\.0, None, 3\.0\]$"):
+        actuator_fault_observer(model, "bias", 0.05, [1.0, None, 3.0])
+    obs = actuator_fault_observer(model, "bias", 0.05, [1.0, 2.0, 3.0])
+    assert obs.reads_u.names == ("tau_d.X", "tau_d.Y", "tau_d.N")
+    assert obs.reads_u.group == "desired force"
