@@ -21,6 +21,7 @@ from uvsym.verify import (
     lyapunov_decrease,
     prove_identity,
     region_decrease,
+    synthesis,
     synthesize_observer_gain,
 )
 from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
@@ -344,3 +345,33 @@ def test_synthesis_keeps_equalities_on_P_and_names_its_claim():
     assert abs(design.P[0, 1]) <= 1e-6 * np.abs(design.P).max()
     assert max(np.linalg.eigvals(A - design.L @ C).real) <= -0.05
     assert design.certificate.claim == "observer error decays"
+
+
+def test_exact_zero_sees_through_a_piecewise_atom():
+    """A Piecewise (what a CasADi comparison or if_else becomes) is one atom P: P (x + 1) - P x - P = 0 by
+    distributivity whatever P is, and P (x + 1) - P x = P is not identically zero."""
+    x = sp.Symbol("x")
+    P = sp.Piecewise((x, x < 1), (0, True))
+    assert identity.exact_zero(P * (x + 1) - P * x - P)
+    assert not identity.exact_zero(P * (x + 1) - P * x)
+
+
+def test_synthesis_falls_back_to_the_rate_itself_and_still_certifies_it():
+    """A = diag(-1, 0.5), C = (0, 1): the mode -1 is unseen, so rate 0.995 is reachable but 1 % more (1.005) is not
+    (by hand: the LMI's x1 entry is 2 (rate - 1) p1). The fallback LMI at 0.995 itself must still leave a strict
+    margin for the exact re-check: the certified closed loop has both eigenvalues at or below -0.995."""
+    A, C = np.diag([-1.0, 0.5]), np.array([[0.0, 1.0]])
+    design = synthesize_observer_gain(A, C, decay=0.995)
+    assert design.certificate.status == "proved"
+    assert max(np.linalg.eigvals(A - design.L @ C).real) <= -0.995
+
+
+@pytest.mark.parametrize("reason, shown", [("", "exact test of A - L C"), ("too close to call", "too close to call")])
+def test_an_uncertified_gain_says_why_or_else_how_it_was_checked(monkeypatch, reason, shown):
+    """When the exact re-check does not prove the decay, the error shows the certificate's reason, or its method
+    when it gives no reason."""
+    monkeypatch.setattr(synthesis, "lyapunov_decrease", lambda claim, vertices, decay, where: Certificate(
+        claim, where, "exact test of A - L C", "inconclusive", reason=reason))
+    with pytest.raises(UvsymError, match=rf"^the synthesised gain could not be certified at decay 1 1/s "
+                                         rf"\(inconclusive: {shown}\)$"):
+        synthesize_observer_gain(np.array([[0.0, 1.0], [-2.0, -0.1]]), np.array([[1.0, 0.0]]), decay=1.0)
