@@ -469,3 +469,14 @@ def test_configuration_labels_and_exact_equilibrium_values():
     np.testing.assert_array_equal(B6[[0, 1, 5]], B3)
     with pytest.raises(ConfigurationError, match=r"^docking_auv: B must be a finite k x m matrix with 1 <= k <= 6 "):
         actuator_values(config, np.zeros(6), rows=[])  # no force rows at all
+
+
+def test_a_weakened_actuator_that_saturates_hands_the_rest_to_one_acting_on_the_same_force():
+    """Two actuators on one force (B = [1, 1]), the first at half effectiveness: u_d = (1, 0) asks 1 N, the
+    linear correction commands 2 on the first, beyond its bound 1. The bounded least squares must then deliver
+    0.5 u_0 + u_1 = 1 exactly (e.g. u = (1, 0.5)); weighting by 1 / effectiveness would deliver 1.5."""
+
+    faults = {"a": ActuatorFaultEstimate("a", "proportional", 0.5, 1.0)}
+    u_star = corrected_commands([1.0, 0.0], faults, ("a", "b"), np.array([[1.0, 1.0]]), [-1.0, -1.0], [1.0, 1.0])
+    assert np.all(np.abs(u_star) <= 1.0 + 1e-12)
+    assert 0.5 * u_star[0] + u_star[1] == pytest.approx(1.0, abs=1e-9)
