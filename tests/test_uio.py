@@ -353,3 +353,46 @@ def test_claim_margins_methods_evidence_and_time_are_stated():
     assert refuted.counterexample == {"unobservable_eigenvalue": 2.0, "eigenvalue_modulus": 2.0, "rho": 1.0,
                                       "eigenvector": [1.0, 0.0]}
     assert refuted.counterexample_summary() == "the sampled map has an eigenvalue of modulus 2 >= 1"
+
+
+def test_bands_with_fewer_outputs_than_states_are_the_observers_exact_residual_hull():
+    """C (2, 3): no reduction in 3 steps, so the band is the exact hull of r_k over the box of (e_0, v_0..v_2).
+
+    The residual the Observer publishes is linear in (e_0, v): plant at rest (x = 0, y = v), prior -e_0. Its
+    coefficients come from runs on unit vectors; the hull radius is sum_j |coefficient_j| * bound_j."""
+    d, _ = _small_observer()
+    ebar, vbar, steps = np.array([0.05, 0.02, 0.01]), np.array([0.01, 0.03]), 3
+    bands = residual_bands(d, vbar, ebar, steps, generators=24)
+    assert bands.upper.shape == (steps, 2)
+    radius = np.zeros((steps, 2))
+    for j in range(3):
+        _, obs = _small_observer(prior=-np.eye(3)[j])
+        _, out = obs.run(np.zeros((steps, 2)), np.zeros((steps, 1)))
+        radius += np.abs(out[:, 3:]) * ebar[j]
+    _, obs = _small_observer()
+    for k in range(steps):
+        for j in range(2):
+            y = np.zeros((steps, 2))
+            y[k, j] = 1.0
+            _, out = obs.run(y, np.zeros((steps, 1)))
+            radius += np.abs(out[:, 3:]) * vbar[j]
+    np.testing.assert_allclose(bands.upper, radius, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(bands.lower, -radius, rtol=1e-9, atol=1e-15)
+    with pytest.raises(SetError, match=r"^noise bound must have shape \(2\), got \(3,\)$"):
+        residual_bands(d, [0.01] * 3, ebar, steps, 24)
+    with pytest.raises(SetError, match=r"^initial error bound must have shape \(3\), got \(2,\)$"):
+        residual_bands(d, vbar, [0.1, 0.1], steps, 24)
+    assert residual_bands(d, vbar, ebar, steps, 24, track=False).reductions == []
+
+
+def test_outside_band_edges_are_inside_and_wrong_shapes_are_named():
+    """The hull is closed: a residual on its edge (tolerance 0) is no alarm, a step beyond it is."""
+    d = uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4])
+    bands = residual_bands(d, [0.01, 0.03], [0.05] * 3, 2, generators=24)
+    for edge in (bands.lower, bands.upper):
+        assert outside_band(edge, bands, tolerance=0.0).tolist() == [False, False]
+    beyond = bands.upper + np.array([[0.0, 0.0], [0.0, 1e-9]])
+    assert outside_band(beyond, bands, tolerance=0.0).tolist() == [False, True]
+    for bad, shape in ((np.zeros((3, 2)), r"\(3, 2\)"), (np.zeros((2, 3)), r"\(2, 3\)"), (np.zeros(2), r"\(2,\)")):
+        with pytest.raises(SetError, match=r"^residuals must be \(N, 2\[, runs\]\) with N <= 2, got " + shape + "$"):
+            outside_band(bad, bands)
