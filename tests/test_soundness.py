@@ -375,3 +375,82 @@ def test_an_uncertified_gain_says_why_or_else_how_it_was_checked(monkeypatch, re
     with pytest.raises(UvsymError, match=rf"^the synthesised gain could not be certified at decay 1 1/s "
                                          rf"\(inconclusive: {shown}\)$"):
         synthesize_observer_gain(np.array([[0.0, 1.0], [-2.0, -0.1]]), np.array([[1.0, 0.0]]), decay=1.0)
+
+
+def test_synthesis_scalar_optimum_matches_the_closed_form():
+    # n = p = 1, A = 0, C = c: minimise P + |Y| s.t. P >= 1, 2 d P - 2 c Y <= -1e-6 with d = 1.01 + 1e-6,
+    # so P = 1 and L = Y = (d + 5e-7) / c.
+    c = 1e-5
+    design = synthesize_observer_gain([[0.0]], [[c]], decay=1.0)
+    assert design.P[0, 0] == pytest.approx(1.0, abs=1e-6)
+    assert design.L[0, 0] == pytest.approx((1.01 + 1.5e-6) / c, abs=5e-3)
+
+
+def test_synthesis_diagonal_optimum_is_the_frobenius_minimiser():
+    # C = I, A = diag(2, 0): with P = I the LMI asks Y + Y^T >= 2 diag(A + d) + 1e-6 I, whose least Frobenius
+    # norm is Y = diag(a_i + d + 5e-7); d = 1.01 + 1e-6. The spectral norm would leave Y[1, 1] free.
+    design = synthesize_observer_gain(np.diag([2.0, 0.0]), np.eye(2), decay=1.0)
+    np.testing.assert_allclose(design.L, np.diag([3.0100015, 1.0100015]), atol=1e-4)
+    np.testing.assert_array_equal(design.P, design.P.T)  # P is a symmetric variable, not symmetrised by the solver
+
+
+def test_synthesis_passes_P_and_Y_to_the_equality_constraints():
+    # Y fixed at 5 by an equality: 2 d P <= 10 - 1e-6 allows P = 1, so L = Y / P = 5.
+    design = synthesize_observer_gain([[0.0]], [[1.0]], decay=1.0, equalities=[lambda P, Y: Y == 5.0])
+    assert design.L[0, 0] == pytest.approx(5.0, abs=1e-5)
+
+
+def test_synthesis_names_the_columns_C_must_have_from_the_rows_of_A():
+    with pytest.raises(VerificationError, match=r"C have 2 columns; got A \(2, 3\)"):
+        synthesize_observer_gain(np.ones((2, 3)), np.ones((1, 3)), 1.0)
+
+
+def _patched_solve(monkeypatch, after):
+    """Replace cvxpy's Problem.solve by the real one followed by ``after(problem)``."""
+    import cvxpy as cp
+
+    real = cp.Problem.solve
+
+    def solve(self, *args, **kwargs):
+        result = real(self, *args, **kwargs)
+        after(self)
+        return result
+
+    monkeypatch.setattr(cp.Problem, "solve", solve)
+
+
+def test_synthesis_silences_only_the_inaccurate_solution_warning(monkeypatch):
+    import warnings
+
+    inaccurate = "Solution may be inaccurate. Try another solver."
+    _patched_solve(monkeypatch, lambda problem: warnings.warn(inaccurate, stacklevel=2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
+    _patched_solve(monkeypatch, lambda problem: warnings.warn("something else", UserWarning, stacklevel=2))
+    with pytest.warns(UserWarning, match="something else"):
+        synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
+
+
+def test_synthesis_accepts_an_optimal_inaccurate_solution(monkeypatch):
+    def inaccurate(problem):
+        problem._status = "optimal_inaccurate"
+
+    _patched_solve(monkeypatch, inaccurate)
+    design = synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
+    assert design.certificate.status == "proved"
+
+
+def test_synthesis_rejects_a_solution_with_values_but_no_optimal_status(monkeypatch):
+    def limited(problem):
+        problem._status = "user_limit"
+
+    _patched_solve(monkeypatch, limited)
+    with pytest.raises(UvsymError, match="no observer gain with decay 0.5 1/s: the LMI at .*user_limit"):
+        synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
+
+
+def test_synthesis_names_a_non_finite_gain(monkeypatch):
+    monkeypatch.setattr(synthesis.np.linalg, "solve", lambda a, b: np.full_like(b, np.nan))
+    with pytest.raises(UvsymError, match="^L has entries that are not finite"):
+        synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
