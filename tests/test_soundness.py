@@ -461,3 +461,11 @@ def test_synthesis_names_a_non_finite_gain(monkeypatch):
     monkeypatch.setattr(synthesis.np.linalg, "solve", lambda a, b: np.full_like(b, np.nan))
     with pytest.raises(UvsymError, match="^L has entries that are not finite"):
         synthesize_observer_gain([[-1.0]], [[1.0]], decay=0.5)
+
+
+def test_synthesis_keeps_P_symmetric_under_an_equality_on_one_entry():
+    # A = -2 I is stable at the rate asked, so Y = 0; P >= I with P[0, 1] = 1/2 and least trace is
+    # [[3/2, 1/2], [1/2, 3/2]] ((p1 - 1)(p2 - 1) >= 1/4 at p1 = p2). A non-symmetric P would let P[1, 0] cancel it.
+    design = synthesize_observer_gain(-2 * np.eye(2), np.eye(2), decay=0.5, equalities=[lambda P, Y: P[0, 1] == 0.5])
+    np.testing.assert_allclose(design.P, [[1.5, 0.5], [0.5, 1.5]], atol=1e-5)
+    np.testing.assert_allclose(design.L, np.zeros((2, 2)), atol=1e-5)
