@@ -480,3 +480,15 @@ def test_a_weakened_actuator_that_saturates_hands_the_rest_to_one_acting_on_the_
     u_star = corrected_commands([1.0, 0.0], faults, ("a", "b"), np.array([[1.0, 1.0]]), [-1.0, -1.0], [1.0, 1.0])
     assert np.all(np.abs(u_star) <= 1.0 + 1e-12)
     assert 0.5 * u_star[0] + u_star[1] == pytest.approx(1.0, abs=1e-9)
+
+
+def test_actuator_values_lists_every_pair_that_trades_separated_by_semicolons():
+    from uvsym.models.configurations import ActuatorConfiguration
+
+    pair = ActuatorConfiguration("pair", np.array([[1.0, 1.0]]), ("a", "b"), (("all", (0, 1)),))  # 1 force, 2 inputs
+    reason = "{} can be traded against {} without changing tau (rank 1 < 2 inputs)"
+    expected = (f"pair: actuator values cannot be recovered from tau: "
+                f"{reason.format('a', 'b')}; {reason.format('b', 'a')}")
+    with pytest.raises(IdentifiabilityError) as info:
+        actuator_values(pair, [1.0], rows=[0])
+    assert str(info.value) == expected
