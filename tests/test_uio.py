@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from uvsym.errors import ObserverError, SetDivergenceError, SetError, UIOConditionError
+from uvsym.errors import ModelError, ObserverError, SetDivergenceError, SetError, UIOConditionError
 from uvsym.observers.uio import uio_conditions, uio_matrices, uio_observer, unobservable_modes
 from uvsym.observers.uio_bank import isolate, outside_band, residual_bands, uio_bank
 from uvsym.systems import signals
@@ -396,3 +396,140 @@ def test_outside_band_edges_are_inside_and_wrong_shapes_are_named():
     for bad, shape in ((np.zeros((3, 2)), r"\(3, 2\)"), (np.zeros((2, 3)), r"\(2, 3\)"), (np.zeros(2), r"\(2,\)")):
         with pytest.raises(SetError, match=r"^residuals must be \(N, 2\[, runs\]\) with N <= 2, got " + shape + "$"):
             outside_band(bad, bands)
+
+
+def test_size_and_option_errors_name_the_matrix_the_free_dimension_and_every_choice():
+    with pytest.raises(ObserverError, match=r"^UIO: C must be a \(any, 3\) matrix, got shape \(2, 2\)$"):
+        uio_conditions(A3, np.eye(2), D3)
+    with pytest.raises(ObserverError, match=r"^UIO: A must be a numeric matrix, got str$"):
+        uio_conditions("A", C3, D3)
+    with pytest.raises(ObserverError, match=r"^UIO: D must be a \(3, any\) matrix, got shape \(2, 1\)$"):
+        uio_conditions(A3, C3, [[1.0], [0.0]])
+    with pytest.raises(ObserverError, match=r"^UIO: unknown time domain 'Discrete'; known: discrete, continuous$"):
+        uio_conditions(A3, C3, D3, time="Discrete")
+    with pytest.raises(ObserverError, match=r"^UIO: B must be a \(3, any\) matrix, got shape \(2, 1\)$"):
+        uio_matrices(A3, [[1.0], [0.0]], C3, D3, poles=[0.2, 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^UIO: B must be a numeric matrix, got str$"):
+        uio_matrices(A3, "B", C3, D3, poles=[0.2, 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^UIO: C must be a numeric matrix, got str$"):
+        unobservable_modes(A3, "C")
+    with pytest.raises(ObserverError, match=r"^UIO: A must be square, got shape \(2, 3\)$"):
+        unobservable_modes(np.ones((2, 3)), [[1.0, 0.0, 0.0]])
+    with pytest.raises(ObserverError, match=r"^UIO: C must be a \(any, 2\) matrix, got shape \(1, 3\)$"):
+        unobservable_modes(np.eye(2), [[1.0, 0.0, 0.0]])
+    with pytest.raises(ObserverError, match=r"^UIO: unknown time domain 'hybrid'; known: discrete, continuous$"):
+        unobservable_modes(np.eye(2), [[1.0, 0.0]], time="hybrid")
+
+
+def test_rank_tolerance_is_absolute_below_one_and_a_singular_value_on_it_is_zero():
+    """A = I/2, D = e1, C = (c, 0): C D = (c), one singular value c; the tolerance is 1e-9 * max(1, c) = 1e-9.
+    c = 1e-9 sits on it (rank 0 < rank D = 1), c = 1.5e-9 is above it (M = 1/c, T = diag(0, 1))."""
+    with pytest.raises(UIOConditionError, match=r"^UIO: rank\(C D\) = 0 but rank\(D\) = 1: the unknown input cannot "
+                                                r"be decoupled from these outputs$") as info:
+        uio_conditions(0.5 * np.eye(2), [[1e-9, 0.0]], [[1.0], [0.0]])
+    assert info.value.ranks == (0, 1)
+    M, _, T, _ = uio_conditions(0.5 * np.eye(2), [[1.5e-9, 0.0]], [[1.0], [0.0]])
+    np.testing.assert_allclose(M, [[1 / 1.5e-9]], rtol=1e-12)
+    np.testing.assert_allclose(T, np.diag([0.0, 1.0]), atol=1e-12)
+
+
+def test_no_unknown_input_leaves_the_plant_as_it_is():
+    """D with no columns: M is (0, p), Q = D M = 0, T = I, A1 = A (a plain Luenberger observer)."""
+    M, Q, T, A1 = uio_conditions(A3, C3, np.zeros((3, 0)))
+    assert M.shape == (0, 2)
+    np.testing.assert_array_equal(Q, np.zeros((3, 2)))
+    np.testing.assert_array_equal(T, np.eye(3))
+    np.testing.assert_array_equal(A1, A3)
+
+
+def test_a_mode_on_the_stability_margin_counts_as_not_stable():
+    """Unmeasured scalar modes (C = 0): discrete |lambda| >= 1 - 1e-9, continuous Re lambda >= -1e-9."""
+    assert unobservable_modes([[1.0 - 1e-9]], [[0.0]]) == [1.0 - 1e-9]
+    assert unobservable_modes([[-(1.0 - 1e-9)]], [[0.0]]) == [-(1.0 - 1e-9)]
+    assert unobservable_modes([[1.0 - 2e-9]], [[0.0]]) == []
+    assert unobservable_modes([[-1e-9]], [[0.0]], time="continuous") == [-1e-9]
+    assert unobservable_modes([[-2e-9]], [[0.0]], time="continuous") == []
+
+
+def test_not_detectable_lists_every_unobservable_mode_in_its_time_domain():
+    """D = e3, C = e3^T: T = diag(1, 1, 0), T A = diag(2, 3, 0) for A = diag(2, 3, a); C sees only x3, so the
+    eigenvalues 2 and 3 are unobservable (unstable in both time domains), 0 is stable in discrete time."""
+    D, C = [[0.0], [0.0], [1.0]], [[0.0, 0.0, 1.0]]
+    with pytest.raises(UIOConditionError, match=r"^UIO: \(C, T A\) is not detectable: eigenvalues with \|lambda\| >= 1 "
+                                                r"unobservable from C: 2\+0j, 3\+0j$") as info:
+        uio_conditions(np.diag([2.0, 3.0, 0.5]), C, D)
+    assert info.value.ranks == (1, 1)
+    assert info.value.eigenvalues == (2.0, 3.0)
+    with pytest.raises(UIOConditionError, match=r"^UIO: \(C, T A\) is not detectable: eigenvalues with Re lambda >= 0 "
+                                                r"unobservable from C: 2\+0j, 3\+0j$"):
+        uio_conditions(np.diag([2.0, 3.0, -0.5]), C, D, time="continuous")
+
+
+def test_continuous_design_by_hand_and_its_refusal_as_a_discrete_observer():
+    """A = diag(-2, -1), C = (0, 1), D = e2, B = e1, K1 = e2: C D = 1 so M = 1, Q = e2, T = diag(1, 0),
+    T A = diag(-2, 0), F = T A - K1 C = diag(-2, -1), J = T B = e1, K = K1 + F Q = e2 - e2 = 0. The mode -2 is
+    unobservable: stable in continuous time, not in discrete time (|-2| >= 1)."""
+    A, B, C, D, K1 = np.diag([-2.0, -1.0]), [[1.0], [0.0]], [[0.0, 1.0]], [[0.0], [1.0]], [[0.0], [1.0]]
+    d = uio_matrices(A, B, C, D, K1=K1, time="continuous")
+    assert d.time == "continuous"
+    np.testing.assert_allclose(d.M, [[1.0]], atol=1e-12)
+    np.testing.assert_allclose(d.Q, [[0.0], [1.0]], atol=1e-12)
+    np.testing.assert_allclose(d.T, np.diag([1.0, 0.0]), atol=1e-12)
+    np.testing.assert_allclose(d.A1, np.diag([-2.0, 0.0]), atol=1e-12)
+    np.testing.assert_allclose(d.F, np.diag([-2.0, -1.0]), atol=1e-12)
+    np.testing.assert_allclose(d.J, [[1.0], [0.0]], atol=1e-12)
+    np.testing.assert_allclose(d.K, [[0.0], [0.0]], atol=1e-12)
+    np.testing.assert_allclose(np.sort(d.eigenvalues.real), [-2.0, -1.0], atol=1e-12)
+    with pytest.raises(UIOConditionError, match=r"unobservable from C: -2\+0j$"):
+        uio_matrices(A, B, C, D, K1=K1)
+    with pytest.raises(ObserverError, match=r"^uio: uio_observer runs a discrete design, got a continuous one$"):
+        uio_observer(d, states=_group("x", 2, "state"), outputs=_group("y", 1, "output"),
+                     inputs=_group("u", 1, "input"), dt=H)
+
+
+def test_pole_errors_word_for_word_and_exact_rational_poles():
+    with pytest.raises(ObserverError, match=r"^UIO: give exactly one of poles \(F's eigenvalues\) and K1 "
+                                            r"\(the gain\)$"):
+        uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4], K1=np.zeros((3, 2)))
+    with pytest.raises(ObserverError, match=r"^UIO: poles must be 3 finite eigenvalues, got 2$"):
+        uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3])
+    with pytest.raises(ObserverError, match=r"^UIO: poles must be 3 finite eigenvalues, got 3$"):
+        uio_matrices(A3, B3, C3, D3, poles=[0.2, np.nan, 0.4])
+    with pytest.raises(ObserverError, match=r"^UIO: poles must be numbers, got \['fast', 0\.3, 0\.4\]$"):
+        uio_matrices(A3, B3, C3, D3, poles=["fast", 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^UIO: poles cannot be placed: \S"):  # 3 times > rank C = 2
+        uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.2, 0.2])
+    d = uio_matrices(A3, B3, C3, D3, poles=[Fraction(1, 5), Fraction(3, 10), Fraction(2, 5)])
+    np.testing.assert_allclose(np.sort(d.eigenvalues.real), [0.2, 0.3, 0.4], atol=1e-9)
+
+
+def test_a_partial_placement_names_the_eigenvalues_it_got():
+    """A = diag(0.5, 0.6, a), C = (e1, e2)^T, D = e2: C's third column is 0, so e3 is an eigenvector of
+    T A - K1 C with eigenvalue a = 0.1234567 whatever K1 is (stable: detectable, not observable); the placement
+    puts -0.5 and 0.2 and keeps a in place of 0.3: sorted, a miss of at most 0.1 (< 1) that is still refused."""
+    with pytest.raises(ObserverError, match=r"^UIO: poles cannot be placed \(placement needs \(C, T A\) observable, "
+                                            r"not only detectable\); got eigenvalues "
+                                            r"\[\(-0\.5\+0j\), \(0\.123457\+0j\), \(0\.2\+0j\)\]: give K1 instead$"):
+        uio_matrices(np.diag([0.5, 0.6, 0.1234567]), [[1.0], [0.0], [0.0]], C3, D3, poles=[-0.5, 0.2, 0.3])
+
+
+def test_an_unstable_gain_lists_every_unstable_eigenvalue():
+    """C = I, D = e3: T = diag(1, 1, 0), F = T A - 0 C = diag(2, 3, 0) for A = diag(2, 3, 0.5)."""
+    with pytest.raises(ObserverError, match=r"^UIO: F = T A - K1 C is not stable \(discrete\): eigenvalues "
+                                            r"2\+0j, 3\+0j$"):
+        uio_matrices(np.diag([2.0, 3.0, 0.5]), B3, np.eye(3), [[0.0], [0.0], [1.0]], K1=np.zeros((3, 3)))
+
+
+def test_observer_groups_are_its_own_and_sizes_and_prior_are_named():
+    """Whatever the groups given: state z, measurements, inputs; the published estimates and residuals are two
+    groups, so their sum is a plain "signal" group."""
+    d = uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.3, 0.4])
+    obs = uio_observer(d, states=_group("x", 3, "residual"), outputs=_group("y", 2, "estimate"),
+                       inputs=_group("u", 1, "measurement"), dt=H)
+    assert (obs.state.group, obs.reads_y.group, obs.reads_u.group, obs.publishes.group) == (
+        "state", "measurement", "input", "signal")
+    with pytest.raises(ObserverError, match=r"^uio: inputs has 2 signals, the design 1$"):
+        uio_observer(d, states=_group("x", 3, "state"), outputs=_group("y", 2, "output"),
+                     inputs=_group("u", 2, "input"), dt=H)
+    with pytest.raises(ModelError, match=r"^uio: prior must have 3 entries \(x0, x1, x2\), got 2$"):
+        _small_observer(prior=[1.0, 2.0])

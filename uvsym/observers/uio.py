@@ -74,6 +74,20 @@ def _matrix(value, what: str, rows: int | None = None, cols: int | None = None) 
     return M
 
 
+def _square(A) -> np.ndarray:
+    """A as an (n, n) float matrix; ObserverError naming A otherwise."""
+    A = _matrix(A, "A")
+    rows, cols = A.shape
+    if rows != cols:
+        raise ObserverError(f"UIO: A must be square, got shape {A.shape}")
+    return A
+
+
+def _check_time(time: str) -> None:
+    if time not in TIME_DOMAINS:
+        raise ObserverError(f"UIO: unknown time domain {time!r}; known: {', '.join(TIME_DOMAINS)}")
+
+
 def _rank(M: np.ndarray) -> int:
     s = np.linalg.svd(M, compute_uv=False)
     return int(np.sum(s > RANK_TOLERANCE * max(1.0, s[0] if s.size else 0.0)))
@@ -86,9 +100,13 @@ def _unstable(eigenvalue: complex, time: str) -> bool:
 
 
 def unobservable_modes(A, C, time: str = "discrete") -> list[complex]:
-    """The eigenvalues of A that are unobservable from C (PBH test) and not stable in ``time``."""
-    A, C = _matrix(A, "A"), _matrix(C, "C")
-    n = A.shape[0]
+    """The eigenvalues of A (n, n) that are unobservable from C (p, n) (PBH test) and not stable in ``time``.
+
+    ObserverError for non-conforming sizes, non-finite entries or an unknown time domain."""
+    _check_time(time)
+    A = _square(A)
+    n = len(A)
+    C = _matrix(C, "C", cols=n)
     return [complex(lam) for lam in np.linalg.eigvals(A)
             if _unstable(lam, time) and _rank(np.vstack([A - lam * np.eye(n), C])) < n]
 
@@ -106,12 +124,9 @@ def uio_conditions(A, C, D, time: str = "discrete") -> tuple[np.ndarray, np.ndar
     ObserverError
         For non-conforming sizes, non-finite entries or an unknown time domain.
     """
-    if time not in TIME_DOMAINS:
-        raise ObserverError(f"UIO: unknown time domain {time!r}; known: {', '.join(TIME_DOMAINS)}")
-    A = _matrix(A, "A")
-    n = A.shape[0]
-    if A.shape != (n, n):
-        raise ObserverError(f"UIO: A must be square, got shape {A.shape}")
+    _check_time(time)
+    A = _square(A)
+    n = len(A)
     C, D = _matrix(C, "C", cols=n), _matrix(D, "D", rows=n)
     CD = C @ D
     ranks = (_rank(CD), _rank(D))
@@ -149,7 +164,10 @@ def uio_matrices(A, B, C, D, *, poles=None, K1=None, time: str = "discrete") -> 
     if (poles is None) == (K1 is None):
         raise ObserverError("UIO: give exactly one of poles (F's eigenvalues) and K1 (the gain)")
     if poles is not None:
-        poles = np.asarray(poles, dtype=complex).ravel()
+        try:
+            poles = np.asarray(poles, dtype=complex).ravel()
+        except (TypeError, ValueError):
+            raise ObserverError(f"UIO: poles must be numbers, got {poles!r}") from None
         if poles.size != n or not np.all(np.isfinite(poles)):
             raise ObserverError(f"UIO: poles must be {n} finite eigenvalues, got {poles.size}")
         try:
