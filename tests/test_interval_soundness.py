@@ -125,11 +125,11 @@ def test_the_oracle_samples_zero_and_reports_the_exact_value_to_20_digits(monkey
     violations = enclosure_violations("sq", [(-1.0, 1.0)], np.random.default_rng(0))
     assert len(violations) == 7  # the point 0 of the first box with each of the 7 points of the (0, 0) box
     assert set(violations) == {"sq on [(-1.0, 1.0), (0.0, 0.0)]: 0.0 at [0.0, 0.0] outside "
-                               f"[{np.float64(1e-300)!r}, {np.float64(1.0)!r}]"}
+                               "[1e-300, 1.0]"}
     monkeypatch.setattr(enclosure_check, "_interval_function", _fake_bounds(2.0, 2.5))
     violations = enclosure_violations("exp", [(1.0, 1.0)], np.random.default_rng(0))
     assert violations and set(violations) == {"exp on [(1.0, 1.0), (0.0, 0.0)]: 2.7182818284590452354 at "
-                                              f"[1.0, 0.0] outside [{np.float64(2.0)!r}, {np.float64(2.5)!r}]"}
+                                              "[1.0, 0.0] outside [2.0, 2.5]"}
 
 
 def test_region_cases_failing_at_zero_have_boxes_at_scales_1e_minus_6_to_1e6():

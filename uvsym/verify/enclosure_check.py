@@ -101,5 +101,5 @@ def enclosure_violations(name: str, boxes: list[tuple[float, float]], rng) -> li
             value = oracle(*args)
             if not lo <= value <= hi:
                 violations.append(f"{name} on {boxes}: {mpmath.nstr(value, 20)} at {point.tolist()} outside "
-                                  f"[{lo!r}, {hi!r}]")
+                                  f"[{float(lo)!r}, {float(hi)!r}]")
     return violations
