@@ -358,3 +358,132 @@ def test_step_claim_of_a_silent_input_has_no_bound_and_states_its_claim():
         "proved", 1.0, None, 0.0)
     assert silent.claim == "LMS step mu = 0.1 below the mean-square bound 1 / (M P_u)"
     assert lms_step_claim(0.1, 2, [1.0], claim="mine").claim == "mine"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"order": 0}, "sensor_mon: order M must be a positive integer, got 0"),
+    ({"window": 0}, "sensor_mon: window n must be a positive integer, got 0"),
+    ({"window": 1}, "sensor_mon: window n must be at least 2 samples (R needs a spread), got 1"),
+    ({"confirm": 0}, "sensor_mon: confirm must be a positive integer, got 0"),
+    ({"hold": 0}, "sensor_mon: hold must be a positive integer, got 0"),
+    ({"mu": 0.0}, "sensor_mon: mu must be a positive, finite number, got 0.0"),
+    ({"mu": True}, "sensor_mon: mu must be a positive, finite number, got True"),  # a flag is not a step
+    ({"mu": "0.1"}, "sensor_mon: mu must be a positive, finite number, got '0.1'"),
+    ({"eps0": float("inf")}, "sensor_mon: eps0 must be a positive, finite number, got inf"),
+    ({"r0": -2.0}, "sensor_mon: r0 must be a positive, finite number, got -2.0")])
+def test_bad_settings_give_the_full_message_with_the_monitor_name(kwargs, message):
+    settings = {"order": 2, "mu": 0.01, "eps0": 1.0, "r0": 2.0, "dt": 0.1, "name": "sensor_mon"} | kwargs
+    with pytest.raises(ObserverError) as info:
+        lms_monitor(Y, U, **settings)
+    assert str(info.value) == message
+
+
+def test_bad_names_and_signals_of_the_monitor_are_refused_naming_them():
+    with pytest.raises(ObserverError, match=r"^observer name '2lms' must start with a letter"):
+        lms_monitor(Y, U, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1, name="2lms")
+    two = signals(("u1", "-"), ("u2", "-"), group="input")
+    with pytest.raises(ObserverError, match=r"^lms: regressor must be one signal \(a Signals of size 1\)"):
+        lms_monitor(Y, two, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1)
+
+
+def test_bare_step_and_bound_refuse_bad_arguments_naming_themselves():
+    with pytest.raises(ObserverError, match=r"^lms_step: order M must be a positive integer, got 0$"):
+        lms_step(0)
+    with pytest.raises(ObserverError, match=r"^mu_bound: input power P_u must be a positive, finite number, got 0\.0$"):
+        mu_bound(4, 0.0)
+
+
+def test_the_bare_step_names_itself_and_its_outputs_as_documented():
+    f = lms_step(2)
+    assert f.name() == "lms_fir_step" and f.name_out() == ["C_next", "U_next", "d", "e"]
+
+
+def test_check_mu_warns_at_the_bound_itself_naming_mu_and_the_caller():
+    # M = 4, P_u = 1/4: the bound 1 / (M P_u) is exactly 1, so mu = 1 is "at" it
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert check_mu(1.0, 4, 0.25) == 1.0
+    assert len(caught) == 1 and caught[0].category is StepSizeWarning
+    assert str(caught[0].message) == ("mu = 1 is at or beyond the mean-square stability bound 1 / (M P_u) = 1 "
+                                      "(M = 4, input power P_u = 0.25): the LMS weights may diverge")
+    assert caught[0].filename == __file__  # points at the caller's line, not inside the library
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_mu(0.875, 4, 0.25)  # just below: silent
+
+
+def test_default_window_hold_and_confirm():
+    obs = lms_monitor(Y, U, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1)
+    assert "R window 20, hold 3, confirm 10 samples" in obs.description
+    assert sum(name.startswith("S_") for name in obs.state.names) == 20
+
+
+def test_parameters_publications_and_groups_of_the_monitor():
+    y = signals(("psi", "rad", "heading"), group="output")  # groups other than the monitor's own
+    u = signals(("delta", "-", "rudder"), group="output")
+    r = signals(("psi_ref", "rad", "set-point"), group="signal")
+    obs = lms_monitor(y, u, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1, reference=r)
+    assert (obs.params.names, obs.params.units, obs.params.group) == (("mu", "eps0", "r0"), ("-", "(rad)^2", "-"),
+                                                                      "parameter")
+    assert obs.params.descriptions == ("LMS step", "threshold of eps^2", "threshold of R")
+    assert (obs.reads_y.group, obs.reads_u.group, obs.publishes.group) == ("measurement", "input", "published")
+    assert lms_monitor(y, u, order=2, mu=0.01, eps0=1.0, r0=2.0, dt=0.1).reads_u.group == "input"
+    assert {n: (unit, text) for n, unit, text in zip(*(getattr(obs.publishes, a) for a in (
+            "names", "units", "descriptions")))} == {
+        "psi_fir": ("rad", "live FIR prediction r + d"),
+        "psi_sub": ("rad", "substitute: the frozen filter's prediction while frozen"),
+        "e_psi": ("rad", "prediction error d - (y - r)"), "eps2_psi": ("(rad)^2", "error criterion e^2"),
+        "R_psi": ("-", "weight-drift criterion"), "alarm_eps2_psi": ("-", "eps^2 > eps0"),
+        "alarm_R_psi": ("-", "R > r0"), "frozen_psi": ("-", "filter frozen"), "fault_psi": ("-", "fault confirmed"),
+        "disturbance_psi": ("-", "freeze released: a disturbance")}
+
+
+def test_an_input_without_unit_leaves_the_weights_in_the_unit_of_y():
+    bare = signals(("u", "", "input"), group="input")
+    obs = lms_monitor(Y, bare, order=1, mu=0.01, eps0=1.0, r0=2.0, dt=0.1, window=2)
+    assert obs.state.units[:1] == ("m",) and obs.params.units == ("-", "(m)^2", "-")
+
+
+def test_both_alarms_need_strictly_more_than_their_threshold():
+    # M = 1, n = 2: s = [C, U, S_1, S_2, Cf, frozen, age, fault, count, above]. C = U = 1, y = 1.5: e = -0.5,
+    # e^2 = 1/4. The window becomes (3, 1): two distinct values are each half their gap from the mean, so
+    # their squared z-score is exactly 1 (= n - 1)
+    obs = lms_monitor(Y, U, order=1, mu=0.01, eps0=1.0, r0=1.0, dt=0.1, window=2, hold=1, confirm=3)
+    s = np.array([1.0, 1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+    names = obs.publishes.names
+
+    def alarms(eps0, r0):
+        out = np.asarray(obs.step(s, 1.5, 0.0, [0.01, eps0, r0])[1]).ravel()
+        assert out[names.index("R_y")] == 1.0 and out[names.index("eps2_y")] == 0.25
+        return out[names.index("alarm_eps2_y")], out[names.index("alarm_R_y")]
+
+    assert alarms(0.25, 1.0) == (0.0, 0.0)  # at the thresholds: no alarm
+    assert alarms(0.2, 0.9) == (1.0, 1.0)
+
+
+def test_a_released_freeze_hands_the_substitute_back_to_the_live_filter():
+    # a one-sample disturbance of a perfectly trained filter: frozen from the spike, released confirm = 3
+    # samples later; the live filter is an LMS loop written out here, the frozen one is the true filter
+    M, N, spike, mu = 2, 20, 8, 1 / 64
+    true = np.array([0.5, -0.25])
+    u = np.array([1.0, 2.0, -1.0, 0.0, 3.0] * 4)
+    y = regressors(u, M) @ true
+    y[spike] += 4.0
+    obs = monitor(M=M, mu=mu, eps0=4.0, r0=1e6, confirm=3)
+    s0 = obs.initial_state([0.0], [0.0])
+    s0[:M] = true
+    _, OUT = obs.run(y[:, None], u[:, None], s0=s0)
+    C, live = true.copy(), []
+    for row, target in zip(regressors(u, M), y):
+        live.append(C @ row)
+        C = C - 2 * mu * (C @ row - target) * row
+    names = obs.publishes.names
+    frozen = np.zeros(N)
+    frozen[spike:spike + 3] = 1.0
+    np.testing.assert_array_equal(OUT[:, names.index("frozen_y")], frozen)
+    assert list(np.flatnonzero(OUT[:, names.index("disturbance_y")])) == [spike + 3]
+    sub = OUT[:, names.index("y_sub")]
+    np.testing.assert_allclose(sub[spike + 1:spike + 3], regressors(u, M)[spike + 1:spike + 3] @ true, rtol=1e-12)
+    release = spike + 3
+    assert sub[release] == pytest.approx(live[release], rel=1e-12)
+    assert abs(live[release] - regressors(u, M)[release] @ true) > 1e-3  # the two filters differ there

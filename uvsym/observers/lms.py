@@ -151,7 +151,7 @@ def lms_monitor(measured: Signals, regressor: Signals, *, order: int, mu: float,
                         (f"alarm_eps2_{y_name}", "-", "eps^2 > eps0"), (f"alarm_R_{y_name}", "-", "R > r0"),
                         (f"frozen_{y_name}", "-", "filter frozen"), (f"fault_{y_name}", "-", "fault confirmed"),
                         (f"disturbance_{y_name}", "-", "freeze released: a disturbance"), group="published")
-    reads_u = regressor.renamed(group="input") + (reference.renamed(group="input") if reference else Signals())
+    reads_u = (regressor + reference if reference else regressor).renamed(group="input")
 
     def step(s, y, u, p):
         C, U, W, Cf = s[:M], s[M:2 * M], s[2 * M:2 * M + n], s[2 * M + n:3 * M + n]
