@@ -497,6 +497,8 @@ def test_pole_errors_word_for_word_and_exact_rational_poles():
         uio_matrices(A3, B3, C3, D3, poles=[0.2, np.nan, 0.4])
     with pytest.raises(ObserverError, match=r"^UIO: poles must be numbers, got \['fast', 0\.3, 0\.4\]$"):
         uio_matrices(A3, B3, C3, D3, poles=["fast", 0.3, 0.4])
+    with pytest.raises(ObserverError, match=r"^UIO: poles must be numbers, got 'fast'$"):
+        uio_matrices(A3, B3, C3, D3, poles="fast")
     with pytest.raises(ObserverError, match=r"^UIO: poles cannot be placed: \S"):  # 3 times > rank C = 2
         uio_matrices(A3, B3, C3, D3, poles=[0.2, 0.2, 0.2])
     d = uio_matrices(A3, B3, C3, D3, poles=[Fraction(1, 5), Fraction(3, 10), Fraction(2, 5)])

@@ -154,7 +154,8 @@ def uio_matrices(A, B, C, D, *, poles=None, K1=None, time: str = "discrete") -> 
     UIOConditionError
         When an existence condition fails (see :func:`uio_conditions`).
     ObserverError
-        For sizes, for neither or both of poles and K1, poles that cannot be placed, or a gain
+        For sizes, for neither or both of poles and K1, poles that are not n finite numbers or cannot
+        be placed, or a gain
         that leaves F unstable (names its eigenvalues).
     """
     M, Q, T, A1 = uio_conditions(A, C, D, time)
