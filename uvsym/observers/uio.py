@@ -155,8 +155,7 @@ def uio_matrices(A, B, C, D, *, poles=None, K1=None, time: str = "discrete") -> 
         When an existence condition fails (see :func:`uio_conditions`).
     ObserverError
         For sizes, for neither or both of poles and K1, poles that are not n finite numbers or cannot
-        be placed, or a gain
-        that leaves F unstable (names its eigenvalues).
+        be placed, or a gain that leaves F unstable (names its eigenvalues).
     """
     M, Q, T, A1 = uio_conditions(A, C, D, time)
     n = A1.shape[0]
