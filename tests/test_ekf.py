@@ -102,3 +102,31 @@ def test_filter_describes_its_positive_definiteness_margin():
     obs = ekf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
     described = dict(zip(obs.publishes.names, obs.publishes.descriptions))
     assert described["pd_margin"] == "smallest relative Cholesky pivot of the step (> 0: P.D.)"
+
+
+def test_extended_filter_keeps_its_method_covariances_and_settings():
+    from uvsym.observers.ekf import extended_filter
+
+    filt = extended_filter(linear_plant(), dt=0.1, Q=[1.0, 2.0, 3.0], R=[4.0, 5.0], P0=P0)
+    assert (filt.name, filt.method, filt.settings) == ("ekf", "ekf", {"steps": 1})
+    np.testing.assert_array_equal(filt.Q, np.diag([1.0, 2.0, 3.0]))
+    np.testing.assert_array_equal(filt.R, np.diag([4.0, 5.0]))
+    obs = ekf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
+    assert obs.name == "ekf" and obs.description == "EKF of linear, sampled every 0.1 s"
+
+
+def test_ekf_prediction_takes_the_requested_rk4_steps():
+    # x' = -x: one RK4 step of h multiplies x by g(h) = 1 - h + h^2/2 - h^3/6 + h^4/24, and so does its Jacobian;
+    # steps = 2 over dt = 0.5 is g(0.25)^2 = 0.6065..., one step would be g(0.5) = 0.6068...
+    from uvsym.observers.ekf import extended_filter
+
+    decay = system("decay", "", x=signals(("x", "m")), u=signals(("f", "N")), rhs=lambda x, u, d, p: -x + u)
+    filt = extended_filter(decay, dt=0.5, Q=0.25, R=1.0, P0=1.0, steps=2)
+    assert filt.settings == {"steps": 2}
+
+    def g(h):
+        return 1 - h + h**2 / 2 - h**3 / 6 + h**4 / 24
+
+    x_next, P_next, _ = filt.predict(ca.DM(2.0), ca.DM(3.0), ca.DM(0.0), ca.DM.zeros(0))
+    assert float(x_next) == pytest.approx(2.0 * g(0.25) ** 2, rel=1e-14)
+    assert float(P_next) == pytest.approx(3.0 * g(0.25) ** 4 + 0.25, rel=1e-14)
