@@ -487,3 +487,28 @@ def test_a_released_freeze_hands_the_substitute_back_to_the_live_filter():
     release = spike + 3
     assert sub[release] == pytest.approx(live[release], rel=1e-12)
     assert abs(live[release] - regressors(u, M)[release] @ true) > 1e-3  # the two filters differ there
+
+
+@pytest.mark.parametrize("mu, order, u, message", [
+    (0, 2, [1.0], "lms step claim: mu must be positive and finite, got 0"),  # mu = 0 does not adapt
+    (0.1, 0, [1.0], "lms step claim: order M must be a positive integer, got 0"),
+    (0.1, 2.0, [1.0], "lms step claim: order M must be a positive integer, got 2.0"),
+    (0.1, True, [1.0], "lms step claim: order M must be a positive integer, got True"),
+    (0.1, 2, [], "lms step claim: the input samples u must be finite and at least one")])
+def test_step_claim_refuses_bad_arguments_with_its_full_message(mu, order, u, message):
+    with pytest.raises(VerificationError) as info:
+        lms_step_claim(mu, order, u)
+    assert str(info.value) == message
+
+
+def test_step_claim_takes_a_column_of_samples_and_states_its_set_bound_and_expectation():
+    import time
+
+    u = np.array([[2.0], [0.0]])  # a recorded input as a run gives it, (N, 1): P_u = (4 + 0) / 2 = 2
+    before = time.perf_counter()
+    certificate = lms_step_claim(0.125, 2, u, expected="refuted")  # mu M P_u = 0.125 * 2 * 2 = 1/2
+    elapsed = time.perf_counter() - before
+    assert (certificate.status, certificate.expected, certificate.margin) == ("proved", "refuted", 0.5)
+    assert certificate.details["bound"] == 0.25  # 1 / (M P_u) = 1 / 4
+    assert certificate.set == "the recorded input (2 samples, P_u = 2), M = 2"
+    assert 0.0 < certificate.seconds <= elapsed  # its own duration, measured around the call
