@@ -348,8 +348,33 @@ def test_kinetic_energy_decrease_states_its_claim_and_box_and_is_refuted_without
     # the box is a box of numbers whatever their type: exact fractions, or unsigned integers (which numpy would
     # negate modulo 256, -1 -> 255, putting the box's lower corner above 0)
     for box in ([Fraction(3), Fraction(1), Fraction(1)], np.array([3, 1, 1], dtype=np.uint8)):
-        same = kinetic_energy_decrease("Otter, uncorrected", loop, box, 0.05)
-        assert (same.status, same.set) == ("refuted", "|u (m/s)| <= 3, |v (m/s)| <= 1, |r (rad/s)| <= 1")
+        same = kinetic_energy_decrease("Otter, uncorrected", loop, box, 0.05, expected="refuted")
+        assert (same.status, same.expected, same.set) == (
+            "refuted", "refuted", "|u (m/s)| <= 3, |v (m/s)| <= 1, |r (rad/s)| <= 1")
+
+
+def test_damping_injection_loop_faults_start_at_zero_by_default_and_a_stuck_thruster_hands_over_its_share():
+    from uvsym import vehicle
+    from uvsym.faults import ActuatorFault, Profile
+    from uvsym.verify.fault_tolerant import damping_injection_loop
+
+    model = vehicle("otter3dof")
+    nu = np.array([0.2, -0.1, 0.05])
+
+    def nu_dot(loop):
+        return np.asarray(ca.Function("loop", [loop.nu], [loop.nu_dot])(nu)).ravel()
+
+    later = (ActuatorFault(0, "bias", 13.0, Profile(onset=0.5)),)  # not yet active at the default t = 0 s
+    healthy = _still_water_loop_nu_dot(model, 50.0, nu, lambda u_d: u_d)
+    assert nu_dot(damping_injection_loop(model, 50.0, later)) == pytest.approx(healthy, rel=1e-12, abs=1e-12)
+    # T_R stuck at 20 N, estimated exactly: T_L takes over t (u_d,R - 20) with t the least-squares fit of
+    # B0[:, T_R] by B0[:, T_L] (what T_R no longer adds beyond its 20 N)
+    zero = np.zeros(3)
+    B0 = np.asarray(model.B(zero, zero, np.zeros(2), 0.0, 0.0))
+    t = np.linalg.lstsq(B0[:, :1], B0[:, 1], rcond=None)[0][0]
+    stuck = damping_injection_loop(model, 50.0, (ActuatorFault(1, "constant", 20.0),), (20.0,))
+    expected = _still_water_loop_nu_dot(model, 50.0, nu, lambda u_d: np.array([u_d[0] + t * (u_d[1] - 20.0), 20.0]))
+    assert nu_dot(stuck) == pytest.approx(expected, rel=1e-12, abs=1e-12)
 
 
 def _toy_observer(kind: str):
