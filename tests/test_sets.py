@@ -363,3 +363,33 @@ def test_point_zonotope_slack_is_the_tolerance_whatever_the_centre():
     far = Zonotope([1e6], np.zeros((1, 0)))
     assert far.contains([1e6])
     assert not far.contains([1e6 + 1e-6]) and not far.contains([1e6 - 1e-6])
+
+
+def test_a_numpy_integer_order_is_accepted_and_exactly_the_order_reduces_nothing():
+    """Three generators, none axis-aligned, under an order bound of 3 (given as a numpy integer): nothing is
+    reduced (R = I), whereas a bound of 2 boxes them into (1 + 2 + 0.5, 1 + 1 + 0.3) = (3.5, 2.3)."""
+    G = np.array([[1.0, 2.0, 0.5], [1.0, -1.0, 0.3]])
+    Z = Zonotope([0.0, 0.0], G)
+    same = reduce(Z, np.int64(3))
+    np.testing.assert_array_equal(same.zonotope.generators, G)
+    np.testing.assert_array_equal(same.coefficients, np.eye(3))
+    np.testing.assert_allclose(reduce(Z, np.int64(2), "girard").zonotope.generators, np.diag([3.5, 2.3]),
+                               rtol=1e-15)
+
+
+def test_box_reductions_use_the_compiled_kernel_when_one_is_built(monkeypatch):
+    from uvsym.sets import kernel, reduction
+
+    if kernel.box_reduce(np.eye(2), 2, False) is None:
+        pytest.skip("no C compiler: only the numpy path exists")
+    calls = []
+
+    def spy(*args, **kwargs):
+        calls.append(args[2])
+        return kernel.box_reduce(*args, **kwargs)
+
+    monkeypatch.setattr(reduction, "box_reduce", spy)
+    Z = _random_zonotope(12, 3, 9)
+    for method in ("girard", "combastel", "pca"):
+        reduce(Z, 4, method)
+    assert calls == [False, True]  # combastel flag; PCA has no compiled path
