@@ -9,7 +9,7 @@ from scipy.stats import multivariate_normal
 from test_ukf import P0, X0, A, B, C, Q, R, linear_plant
 
 from uvsym.errors import ObserverError
-from uvsym.observers.ekf import extended_filter
+from uvsym.observers.ekf import ekf, extended_filter
 from uvsym.observers.kalman import run_filter
 from uvsym.observers.mmae import log_normalised, mmae_bank
 from uvsym.observers.ukf import unscented_filter
@@ -164,3 +164,107 @@ def test_the_bank_reads_inputs_and_parameters_by_name():
         bank.parameters({"k": 1.0})
     with pytest.raises(ObserverError, match=r"^no input named \['g'\]; known: f$"):
         bank.initial_state([0.0, 0.0], {"f": 0.0, "g": 1.0})
+
+
+def scalar_filter(name, gain=1.0, *, dt=0.1, k0=1.0, extra=0):
+    """EKF of a' = -k a + f (plus ``extra`` decaying states e0, e1, ...), y = (a, gain a), R = I, P0 = I."""
+    n = 1 + extra
+    x = signals(("a", "m", "position"), *[(f"e{i}", "-") for i in range(extra)], group="state")
+    plant = system(name, "", x=x, u=signals(("f", "N")), p=signals(("k", "1/s")), p0=[k0],
+                   rhs=lambda x, u, d, p: -p[0] * x + ca.vertcat(u, ca.SX.zeros(extra)),
+                   y=signals(("y1", "m"), ("y2", "m")), output=lambda x, u, p: ca.vertcat(x[0], gain * x[0]))
+    return extended_filter(plant, dt=dt, Q=0.01 * np.eye(n), R=np.eye(2), P0=np.eye(n), x0=np.ones(n), name=name)
+
+
+def test_log_normalised_takes_its_shift_also_from_the_first_entry():
+    v = np.array([900.0, 0.0, -3.0])  # the largest first: a shift from the others alone overflows exp
+    got = np.asarray(ca.Function("f", [s := ca.SX.sym("v", 3)], [log_normalised(s)])(v)).ravel()
+    np.testing.assert_allclose(got, [0.0, -900.0, -903.0], atol=1e-12)
+
+
+def test_the_bank_labels_its_state_and_takes_name_parameters_and_signals_from_the_first_model():
+    bank = mmae_bank({"one": scalar_filter("one", k0=1.5), "two": scalar_filter("two", 0.5, k0=2.0)})
+    assert bank.name == "mmae"
+    assert bank.state.names == ("one.a_hat", "one.P.a.a", "two.a_hat", "two.P.a.a", "logp.one", "logp.two")
+    assert bank.state.units == ("m", "m m", "m", "m m", "-", "-")
+    assert bank.state.descriptions[-2:] == ("log probability of model one", "log probability of model two")
+    assert bank.state.group == "state"
+    np.testing.assert_array_equal(bank.p0, [1.5])  # the first model's default k, not the second's 2.0
+    assert (bank.params.names, bank.params.group) == (("k",), "parameter")
+    assert (bank.reads_y.names, bank.reads_y.group, bank.reads_u.group) == (("y1", "y2"), "measurement", "input")
+    described = dict(zip(bank.publishes.names, bank.publishes.descriptions))
+    assert [described[n] for n in ("p_one", "pd_margin", "skipped")] == [
+        "probability of model one", "smallest relative Cholesky pivot of the bank's step (> 0: P.D.)",
+        "1 where y_k had a NaN and the updates were skipped"]
+
+
+@pytest.mark.parametrize("order", [("twin", "half"), ("half", "twin")])
+def test_pd_margin_is_the_smallest_pivot_over_every_model(order):
+    # first update, P = 1, R = I: S = [[2, g], [g, 1 + g^2]], relative pivots 1 and 1 - g^2 / (2 (1 + g^2)):
+    # 3/4 for g = 1 (twin), 0.9 for g = 1/2 (half); the scalar predictions' pivots are 1
+    gains = {"twin": 1.0, "half": 0.5}
+    bank = mmae_bank({m: scalar_filter(m, gains[m]) for m in order})
+    _, OUT = run_filter(bank, np.array([[0.3, -0.2]]), np.array([[0.0]]))
+    assert OUT[0, bank.publishes.names.index("pd_margin")] == pytest.approx(0.75, abs=1e-9)
+
+
+def test_a_model_with_own_states_first_publishes_them_as_a_lone_filter_would():
+    deep = scalar_filter("deep", extra=5)
+    bank = mmae_bank({"deep": deep, "one": scalar_filter("one", 0.5)}, reset=False)  # the filters run apart
+    rng = np.random.default_rng(4)
+    Y, U = rng.normal(size=(6, 2)), rng.normal(size=(6, 1))
+    alone = ekf(deep.system, dt=0.1, Q=0.01 * np.eye(6), R=np.eye(2), P0=np.eye(6), x0=np.ones(6), name="deep")
+    own = [f"e{i}_hat" for i in range(5)]
+    got = run_filter(bank, Y, U)[1][:, [bank.publishes.names.index(f"deep.{n}") for n in own]]
+    np.testing.assert_allclose(got, run_filter(alone, Y, U)[1][:, alone.publishes.indices(own)], atol=1e-12)
+    np.testing.assert_allclose(got[:, 0], np.exp(-0.1 * np.arange(6)), rtol=1e-6)  # e' = -e from 1, unmeasured
+
+
+def test_a_six_state_model_may_come_last():
+    bank = mmae_bank({"one": scalar_filter("one"), "deep": scalar_filter("deep", extra=5)})
+    assert bank.state.size == (1 + 1) + (6 + 21) + 2  # x, tril(P) of each model, then the log-probabilities
+    assert bank.state.names[-3:] == ("deep.P.e4.e4", "logp.one", "logp.deep")
+    _, OUT = run_filter(bank, np.array([[0.3, -0.2]]), np.array([[0.0]]))
+    assert OUT[0, bank.publishes.indices(["p_one", "p_deep"])].sum() == pytest.approx(1.0, abs=1e-12)
+
+
+def test_bad_bank_arguments_are_named_word_for_word():
+    one, two = scalar_filter("one"), scalar_filter("two", 0.5)
+    with pytest.raises(ObserverError, match=r"^observer name 'no good' must start with a letter"):
+        mmae_bank({"one": one, "two": two}, name="no good")
+    for p_min in (0.0, 0.5):  # the open interval (0, 1/2) for two models
+        with pytest.raises(ObserverError, match=rf"^mmae: p_min must be in \(0, 1/2\), got {p_min}$"):
+            mmae_bank({"one": one, "two": two}, p_min=p_min)
+    for prior in ((1.0, 1.0, 1.0), (1.0, 0.0), (None, 1.0), ("x", 1.0)):
+        with pytest.raises(ObserverError) as error:
+            mmae_bank({"one": one, "two": two}, prior=prior)
+        assert str(error.value) == "mmae: prior must be 2 positive probabilities (one, two)"
+    with pytest.raises(ObserverError) as error:
+        mmae_bank({"one": one, "two": object()})
+    assert str(error.value) == "model two: expected a GaussianFilter (unscented_filter, extended_filter), got object"
+    apart = extended_filter(system("apart", "", x=signals(("z", "m"), group="state"), u=signals(("f", "N")),
+                                   p=signals(("k", "1/s")), rhs=lambda x, u, d, p: -x,
+                                   y=signals(("y1", "m"), ("y2", "m")), output=lambda x, u, p: ca.vertcat(x, x)),
+                            dt=0.1, Q=1.0, R=np.eye(2), P0=1.0)
+    with pytest.raises(ObserverError) as error:
+        mmae_bank({"one": one, "apart": apart})
+    assert str(error.value) == "the bank's models share no state to fuse"
+
+
+def test_an_unnormalised_prior_is_normalised():
+    bank = mmae_bank({"one": scalar_filter("one"), "two": scalar_filter("two", 0.5)}, prior=(3, 1))
+    np.testing.assert_allclose(bank.initial_state([0.0, 0.0], [0.0])[-2:], np.log([0.75, 0.25]), rtol=1e-15)
+
+
+def test_sample_periods_agree_to_one_part_in_a_million_million_of_the_first():
+    dt = 2.0**-43 / 1e-12  # 1e-12 dt is 2^-43 exactly, and dt + 2^-43 is a float 2^-43 away from dt
+    assert 1e-12 * dt == 2.0**-43 and (dt + 2.0**-43) - dt == 2.0**-43
+    bank = mmae_bank({"one": scalar_filter("one", dt=dt), "two": scalar_filter("two", 0.5, dt=dt + 2.0**-43)})
+    assert bank.dt == dt  # on the boundary: accepted
+    with pytest.raises(ObserverError, match="^model two is sampled every 0.1 s, the first model every 0.1 s$"):
+        mmae_bank({"one": scalar_filter("one"), "two": scalar_filter("two", 0.5, dt=0.1 + 5e-13)})
+    # the bank runs and is described at the first model's period, here just below a 6-digit rounding boundary
+    early, late = 0.10000049999999999, 0.1000005
+    assert (f"{early:g}", f"{late:g}") == ("0.1", "0.100001") and late - early < 1e-12 * early
+    bank = mmae_bank({"one": scalar_filter("one", dt=early), "two": scalar_filter("two", 0.5, dt=late)})
+    assert bank.dt == early and bank.description.endswith("sampled every 0.1 s")

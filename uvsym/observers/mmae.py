@@ -85,9 +85,13 @@ def mmae_bank(filters: dict[str, GaussianFilter], *, name: str = "mmae", p_min: 
     count = len(models)
     if not (isinstance(p_min, (int, float)) and 0.0 < p_min < 1.0 / count):
         raise ObserverError(f"{name}: p_min must be in (0, 1/{count}), got {p_min!r}")
-    prior = np.full(count, 1.0 / count) if prior is None else np.asarray(prior, dtype=float).ravel()
+    wrong_prior = ObserverError(f"{name}: prior must be {count} positive probabilities ({', '.join(models)})")
+    try:
+        prior = np.full(count, 1.0 / count) if prior is None else np.asarray(prior, dtype=float).ravel()
+    except (TypeError, ValueError):  # not numbers
+        raise wrong_prior from None
     if prior.size != count or not np.all(np.isfinite(prior)) or np.any(prior <= 0):
-        raise ObserverError(f"{name}: prior must be {count} positive probabilities ({', '.join(models)})")
+        raise wrong_prior
     prior = prior / prior.sum()
     first = filters[models[0]].system
     sizes = [f.system.x.size for f in filters.values()]
