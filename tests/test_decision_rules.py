@@ -32,16 +32,16 @@ T = np.arange(6) * 0.1  # s
 V = 2.0**-17  # a variance well below the default threshold (1e-4)
 
 
-def decide(records: dict[str, dict], settings=None, tau_d=5.0):
+def decide(records: dict[str, dict], settings=None, tau_d=5.0, first=0):
     """The decision on one channel "X" from per-observer records: kind -> {"var", "mean", "visible"} (each a
-    scalar or a (6,) sequence over T)."""
+    scalar or a (6,) sequence over T), deciding from row ``first`` on."""
     isolator = Isolator({kind: (None, None) for kind in records}, ("X",), settings or IsolationSettings())
     isolator.t, isolator.tau_d = T, np.full((len(T), 1), tau_d)
     for kind, record in records.items():
         isolator.variance[kind] = np.broadcast_to(np.asarray(record["var"], float), T.shape)[:, None].copy()
         isolator.mean[kind] = np.broadcast_to(np.asarray(record["mean"], float), T.shape)[:, None].copy()
         isolator.visible[kind] = np.broadcast_to(np.asarray(record.get("visible", True)), T.shape)[:, None].copy()
-    isolator._decide(0)
+    isolator._decide(first)
     return isolator.decisions.get("X")
 
 
@@ -255,7 +255,7 @@ def test_a_correction_acts_from_the_first_sample_after_the_checked_chunk():
 
 
 def test_an_isolator_needs_an_observer_and_reports_its_faulty_channels_apart():
-    with pytest.raises(ObserverError, match="isolation needs at least one observer"):
+    with pytest.raises(ObserverError, match="^isolation needs at least one observer$"):
         Isolator({}, ("X",))
     decisions = {"X": ChannelDecision("X", "bias", 1.0, 2.0, V), "Y": ChannelDecision("Y", "healthy", 1.5, 0.0, V)}
     result = IsolationResult(T, ("X", "Y"), {}, {}, decisions)
@@ -336,3 +336,54 @@ def test_an_actuators_kind_is_read_where_its_share_of_the_channel_is_largest_not
     diagnosis.isolator = StubIsolator([decided])
     diagnosis.update(T[:3], _signals(3))
     assert diagnosis.identified["delta_ru"].kind == "bias" and diagnosis.identified["delta_rd"].kind == "constant"
+
+
+def test_only_the_rows_from_first_on_are_decided():
+    """Separated from row 0 on; deciding from row 3 (then from the last row alone) dates the decision there."""
+    records = {"bias": {"var": V, "mean": 2.0}, "proportional": {"var": 1.0, "mean": 1.3}}
+    assert decide(records, first=3) == ChannelDecision("X", "bias", T[3], 2.0, V)
+    assert decide(records, first=5).time_s == T[5]
+    assert decide(records, first=6) is None  # no new row
+
+
+def test_a_channel_decided_earlier_does_not_stop_the_next_ones():
+    isolator = Isolator({"bias": (None, None)}, ("X", "Y"))
+    isolator.decisions["X"] = ChannelDecision("X", "healthy", 0.1, 0.0, V)
+    isolator.t, isolator.tau_d = T, np.zeros((6, 2))
+    isolator.variance["bias"], isolator.mean["bias"] = np.full((6, 2), V), np.full((6, 2), 3.0)
+    isolator.visible["bias"] = np.ones((6, 2), bool)
+    isolator._decide(0)
+    assert isolator.decisions["Y"] == ChannelDecision("Y", "bias", T[0], 3.0, V)
+
+
+def test_a_mean_exactly_at_the_healthy_tolerance_is_healthy():
+    """A lone bias observer wins by default; |f_bar| = 2^-4 = healthy_tolerance is settled at no fault (<=), a
+    value one step beyond it names a bias."""
+    settings = IsolationSettings(healthy_tolerance=2.0**-4)
+    assert decide({"bias": {"var": V, "mean": 2.0**-4}}, settings).kind == "healthy"
+    assert decide({"bias": {"var": V, "mean": np.nextafter(2.0**-4, 1.0)}}, settings).kind == "bias"
+
+
+def test_a_variance_exactly_at_the_threshold_has_not_settled():
+    """Variance 2^-14 = threshold: neither a fault nor settled at no fault (both need var < threshold)."""
+    settings = IsolationSettings(threshold=2.0**-14)
+    assert decide({"bias": {"var": 2.0**-14, "mean": 0.0}}, settings) is None
+    assert decide({"bias": {"var": 2.0**-15, "mean": 0.0}}, settings).kind == "healthy"
+
+
+def test_a_healthy_row_needs_an_observer_settled_in_that_row():
+    """The lone observer sees the channel from row 3 on and settles at 0 there: rows 0-2 (nobody voting) are not
+    healthy, row 3 is."""
+    visible = [False, False, False, True, True, True]
+    records = {"bias": {"var": [np.nan] * 3 + [V] * 3, "mean": [np.nan] * 3 + [0.0] * 3, "visible": visible}}
+    assert decide(records).time_s == T[3]
+
+
+def test_a_new_isolator_has_empty_records_of_its_channel_count():
+    isolator = Isolator({"bias": (None, None), "proportional": (None, None)}, ("X", "Y", "N"))
+    result = isolator.result
+    assert result.t.shape == (0,) and result.labels == ("X", "Y", "N")
+    for kind in ("bias", "proportional"):
+        assert result.f_bar[kind].shape == result.variance[kind].shape == (0, 3)
+        assert isolator.mean[kind].shape == isolator.visible[kind].shape == (0, 3)
+        assert isolator.visible[kind].dtype == bool
