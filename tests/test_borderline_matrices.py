@@ -58,16 +58,17 @@ def extreme(monkeypatch):
     return use
 
 
+def _exact(A: np.ndarray) -> sympy.Matrix:
+    """The float matrix (n, n) in exact rationals (every double is one)."""
+    return sympy.Matrix([[sympy.Rational(Fraction(float(v))) for v in row] for row in A])
+
+
 def _spectrum(A: np.ndarray) -> dict:
     """Exact eigenvalues {rational: algebraic multiplicity} of a float matrix (n, n), from its characteristic
     polynomial in rationals (sympy); the multiplicities sum to n only if every eigenvalue is rational."""
     polynomial = _exact(A).charpoly()
     return {Fraction(int(r.p), int(r.q)): m for r, m in sympy.Poly(polynomial.as_expr(), polynomial.gen)
             .ground_roots().items()}
-
-
-def _exact(A: np.ndarray) -> sympy.Matrix:
-    return sympy.Matrix([[sympy.Rational(Fraction(float(v))) for v in row] for row in A])
 
 
 def _nearest(value: float, shifts: tuple, name: str) -> float:
