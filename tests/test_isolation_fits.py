@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from decimal import Decimal
 from fractions import Fraction
 from types import SimpleNamespace
 
@@ -18,7 +19,7 @@ import numpy as np
 import pytest
 
 from uvsym.errors import ObserverError
-from uvsym.observers.isolation import IsolationSettings, Isolator, predicted_faults
+from uvsym.observers.isolation import IsolationSettings, Isolator, _window, predicted_faults
 
 DT = 0.01  # s
 T = np.arange(0.0, 2.0, DT)  # s
@@ -95,7 +96,7 @@ def test_shorter_windows_predict_earlier():
 def test_uneven_sampling_and_mismatched_shapes_are_refused():
     uneven = T.copy()
     uneven[10] += DT / 3
-    with pytest.raises(ObserverError, match="uniformly sampled"):
+    with pytest.raises(ObserverError, match="uniformly sampled estimates at increasing times"):
         predicted_faults(RATES, np.array([5.0, 4.0]), uneven, np.ones((len(T), 2)), np.ones((len(T), 2)))
     with pytest.raises(ObserverError, match="matching rows"):
         predicted_faults(RATES, np.array([5.0, 4.0]), T, np.ones((len(T), 2)), np.ones((len(T) - 1, 2)))
@@ -168,3 +169,93 @@ def test_gains_given_as_exact_fractions_predict_the_fault_like_floats():
     f_bar, visible = predicted_faults(RATES, (Fraction(5), Fraction(4)), T, f_hat, tau_d, IsolationSettings())
     assert visible.all()
     np.testing.assert_allclose(f_bar[W - 1:], np.tile(f, (len(T) - W + 1, 1)), rtol=0, atol=1e-9)
+
+
+def test_the_window_is_the_samples_per_window_s_and_at_least_three():
+    """Two samples 0.01 s apart set the spacing (1 s = 100 samples); samples 10 s apart give the floor of 3, as does a
+    single sample (no spacing yet)."""
+    assert _window(np.array([0.0, 0.01]), 1.0) == 100
+    assert _window(np.array([5.0, 15.0]), 1.0) == 3
+    assert _window(np.array([0.0]), 1.0) == 3
+
+
+def test_sampling_is_uniform_within_one_millionth_of_the_step():
+    """Steps dt = 15625 2^-14 s (so 1e-6 dt = 2^-20 s exactly) with the last one 2^-20 s longer: at the bound, accepted;
+    a deviation of 1e-6 s on a step of 0.01 s (1e-4 of it) is refused, as are repeated times."""
+    dt = 15625 * 2.0**-14
+    assert 1e-6 * dt == 2.0**-20
+    edge = np.array([0.0, dt, 2 * dt, 3 * dt, 4 * dt + 2.0**-20])
+    assert edge[-1] - edge[-2] - dt == 2.0**-20  # the deviation is exact
+    assert _window(edge, 10 * dt) == 10
+    jitter = T.copy()
+    jitter[10] += 1e-6
+    message = "^isolation needs uniformly sampled estimates at increasing times$"
+    with pytest.raises(ObserverError, match=message):
+        _window(jitter, 1.0)
+    with pytest.raises(ObserverError, match=message):
+        predicted_faults(RATES, np.array([5.0, 4.0]), np.zeros(5), np.ones((5, 2)), np.ones((5, 2)))
+
+
+def test_a_window_of_two_samples_is_widened_to_three():
+    """window_s = 0.02 s is 2 samples of 0.01 s: the window holds 3, so the first prediction is at row 2; rates of
+    100 and 200 /s (>= 1 / window_s) keep both channels visible and the exponential fit recovers f exactly."""
+    f, C, a = np.array([1.5, -0.5]), np.array([1.0, 2.0]), np.array([100.0, 200.0])
+    f_hat = f - C * np.exp(-np.outer(T, a))
+    f_bar, visible = predict(f_hat, K=a, window_s=0.02)
+    assert visible.all() and np.isnan(f_bar[:2]).all()
+    np.testing.assert_allclose(f_bar[2:], np.tile(f, (len(T) - 2, 1)), rtol=0, atol=1e-12)
+
+
+def test_visibility_is_a_rate_of_one_per_window():
+    """window_s = 0.5 s: a channel is visible from a rate of 2 /s; 1.5 /s is hidden."""
+    f_hat = np.column_stack([3.0 - np.exp(-5.0 * T), 1.0 + 0 * T])
+    for rate, seen in ((1.5, False), (2.0, True)):
+        _, visible = predict(f_hat, K=(5.0, rate), window_s=0.5)
+        assert visible[:, 0].all() and (visible[:, 1] == seen).all()
+
+
+def test_a_long_record_still_predicts_the_fault_at_its_end():
+    """100 s at 0.1 s (window 10 samples), rates 5 and 4 /s: exp(-a t) falls below the smallest double long before
+    the end, and the exponential fit, weighted relative to each window's end, still gives f = (13, -2)."""
+    t = np.arange(1000) * 0.1
+    f, C, a = np.array([13.0, -2.0]), np.array([13.0, 5.0]), np.array([5.0, 4.0])
+    f_hat = f - C * np.exp(-np.outer(t, a))
+    f_bar, _ = predicted_faults(RATES, a, t, f_hat, np.ones((len(t), 2)), IsolationSettings())
+    np.testing.assert_allclose(f_bar[9:], np.tile(f, (len(t) - 9, 1)), rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("fit", ["line", "quadratic"])
+def test_polynomial_fits_use_the_time_step_not_the_clock(fit):
+    """The same line f_hat = 1 + 2 t sampled from t = 5 s: f_bar = f_hat + f_hat' / a = 1 + 2 t + 2 / a."""
+    t = 5.0 + T
+    a = np.array([5.0, 4.0])
+    f_hat = np.tile(1.0 + 2.0 * t[:, None], (1, 2))
+    f_bar, _ = predicted_faults(RATES, a, t, f_hat, np.ones((len(t), 2)), IsolationSettings(fit=fit))
+    np.testing.assert_allclose(f_bar[W - 1:], (f_hat + 2.0 / a)[W - 1:], rtol=1e-9)
+
+
+def test_the_quadratic_fit_is_the_least_squares_parabola_of_a_cubic_estimate():
+    """f_hat = t^3 is not a parabola: f_bar is the value plus slope / a at the window's end of numpy's own
+    least-squares parabola through the window (np.polyfit), a cubic fit would be exact instead."""
+    a = np.array([5.0, 4.0])
+    f_hat = np.tile((T**3)[:, None], (1, 2))
+    f_bar, _ = predict(f_hat, fit="quadratic")
+    for end in (W - 1, 150, len(T) - 1):
+        p = np.polyfit(T[end - W + 1:end + 1] - T[end], f_hat[end - W + 1:end + 1, 0], 2)
+        np.testing.assert_allclose(f_bar[end], p[2] + p[1] / a, rtol=1e-9)
+        assert abs(f_bar[end, 0] - (T[end] ** 3 + 3 * T[end] ** 2 / 5.0)) > 1e-6
+
+
+def test_decimal_inputs_are_read_as_floats():
+    """Times, estimates and desired actions given as Decimals predict, and are stored, like the same floats."""
+    f_hat = 2.0 - np.exp(-np.outer(T, [5.0, 4.0]))
+    tau_d = np.ones((len(T), 2))
+    expected, _ = predict(f_hat)
+    as_decimal = [Decimal(float(x)) for x in T]  # exact binary values
+    f_bar, _ = predicted_faults(RATES, np.array([5.0, 4.0]), as_decimal, f_hat, tau_d, IsolationSettings())
+    np.testing.assert_array_equal(f_bar, expected)
+    isolator = Isolator({"bias": (RATES, np.array([5.0, 4.0]))}, ("X", "Y"))
+    decimals = np.vectorize(lambda x: Decimal(float(x)), otypes=[object])
+    isolator.update(as_decimal, {"bias": decimals(f_hat)}, decimals(tau_d))
+    assert isolator.tau_d.dtype == isolator.f_hat["bias"].dtype == np.float64
+    np.testing.assert_array_equal(isolator.f_bar["bias"], expected)

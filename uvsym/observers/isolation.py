@@ -94,12 +94,12 @@ class IsolationResult:
 
 
 def _window(t: np.ndarray, window_s: float) -> int:
-    """Samples per window for uniformly spaced times t (ObserverError otherwise)."""
+    """Samples per window (at least 3) for uniformly spaced, increasing times t (ObserverError otherwise)."""
     if len(t) < 2:
         return 3
     dt = float(np.median(np.diff(t)))
-    if np.max(np.abs(np.diff(t) - dt)) > 1e-6 * dt:
-        raise ObserverError("isolation needs uniformly sampled estimates")
+    if not dt > 0 or np.max(np.abs(np.diff(t) - dt)) > 1e-6 * dt:
+        raise ObserverError("isolation needs uniformly sampled estimates at increasing times")
     return max(3, int(round(window_s / dt)))
 
 
