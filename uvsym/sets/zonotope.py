@@ -105,7 +105,9 @@ class Zonotope:
 
     def contains(self, point, tolerance: float = 1e-9) -> bool:
         """True when ``point`` (n,) lies in the zonotope (linear program, HiGHS), allowing
-        ``||xi||_inf <= 1 + tolerance``."""
+        ``||xi||_inf <= 1 + tolerance``; SetError unless ``tolerance`` is finite and >= 0."""
+        if not 0.0 <= tolerance < np.inf:
+            raise SetError(f"containment tolerance must be finite and >= 0, got {tolerance}")
         x = finite_matrix(point, "point", (self.dimension,))
         lower, upper = self.interval_hull()
         slack = tolerance * (1.0 + np.abs(upper - lower))
