@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from uvsym.errors import ObserverError
+from uvsym.observers import isolation
 from uvsym.observers.isolation import IsolationSettings, Isolator, _window, predicted_faults
 
 DT = 0.01  # s
@@ -143,11 +144,19 @@ def test_a_channel_too_slow_to_see_is_hidden_without_a_numerical_warning():
     assert not visible[:, 1].any() and np.isnan(f_bar[:, 1]).all()
 
 
-def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record():
-    """Chunks of 50 samples with a 10-sample window (so later updates recompute only a tail): the record's mean
-    of f_bar is, row by row, the mean of the last 10 predicted faults of the whole record (NaN in the first 18 rows);
-    times given as exact fractions are kept as float seconds."""
-    settings, K, window = IsolationSettings(window_s=0.1), np.array([5.0, 4.0]), 10
+def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record(monkeypatch):
+    """Chunks of 50 samples with a 10-sample window (so later updates recompute only a tail, 3 windows before the new
+    samples): the record's mean of f_bar is, row by row, the mean of the last 10 predicted faults of the whole record
+    (NaN in the first 18 rows); rates of 50 and 40 /s keep both channels visible (>= 1 / window_s); times given as
+    exact fractions are kept as float seconds."""
+    settings, K, window = IsolationSettings(window_s=0.1), np.array([50.0, 40.0]), 10
+    tails = []
+
+    def spy(observer, K, t, f_hat, tau_d, settings):
+        tails.append(len(t))
+        return predicted_faults(observer, K, t, f_hat, tau_d, settings)
+
+    monkeypatch.setattr(isolation, "predicted_faults", spy)
     f_hat, tau_d = np.column_stack([np.sin(3 * T), np.cos(T)]), np.ones((len(T), 2))
     isolator = Isolator({"bias": (RATES, K)}, ("X", "Y"), settings)
     for start in range(0, len(T), 50):
@@ -155,10 +164,15 @@ def test_an_isolator_fed_in_chunks_keeps_the_windowed_means_of_the_whole_record(
         isolator.update(times, {"bias": f_hat[start:start + 50]}, tau_d[start:start + 50])
     assert isolator.t.dtype == np.float64
     f_bar, _ = predicted_faults(RATES, K, T, f_hat, tau_d, settings)
-    expected = np.full_like(f_bar, np.nan)
+    expected, spread = np.full_like(f_bar, np.nan), np.full_like(f_bar, np.nan)
     for row in range(2 * window - 2, len(T)):
         expected[row] = f_bar[row - window + 1:row + 1].mean(axis=0)
+        spread[row] = f_bar[row - window + 1:row + 1].var(axis=0)
+    assert np.isfinite(expected[2 * window - 2:]).all()
+    np.testing.assert_allclose(isolator.f_bar["bias"], f_bar, rtol=0, atol=1e-12)
     np.testing.assert_allclose(isolator.mean["bias"], expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(isolator.variance["bias"], spread, rtol=0, atol=1e-12)
+    assert tails == [50, 80, 80, 80]  # 50 new samples, then 3 windows before them
 
 
 def test_gains_given_as_exact_fractions_predict_the_fault_like_floats():

@@ -152,7 +152,7 @@ class Isolator:
     """Isolation over a growing record: feed chunks with :meth:`update`, read :attr:`result`.
 
     observers: kind -> (ActuatorObserver, K). Each update recomputes only the new samples (and
-    the two windows before them); decisions, once made, are kept.
+    the three windows before them); decisions, once made, are kept.
     """
 
     def __init__(self, observers: dict[str, tuple[ActuatorObserver, np.ndarray]], labels: tuple[str, ...],
