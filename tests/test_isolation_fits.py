@@ -273,3 +273,15 @@ def test_decimal_inputs_are_read_as_floats():
     isolator.update(as_decimal, {"bias": decimals(f_hat)}, decimals(tau_d))
     assert isolator.tau_d.dtype == isolator.f_hat["bias"].dtype == np.float64
     np.testing.assert_array_equal(isolator.f_bar["bias"], expected)
+
+
+def test_a_fit_that_divides_zero_by_zero_or_overflows_is_nan_quietly():
+    """Rate 0 (channel 2): every weight exp(0) = 1, so the fit is 0 / 0 and the channel hidden. Rate 400 /s over a 1 s
+    window with a constant estimate of 1e50 (channel 1): the weights reach their cap e^300, so sum g^2 sum f_hat is
+    about 70 e^600 100 1e50 > 1e308 and overflows: no prediction. Both without a warning, whatever numpy's settings."""
+    f_hat = np.column_stack([np.full(len(T), 1e50), np.cos(T)])
+    with warnings.catch_warnings(), np.errstate(all="raise"):
+        warnings.simplefilter("error")
+        f_bar, visible = predict(f_hat, K=(400.0, 0.0))
+    assert visible[:, 0].all() and not visible[:, 1].any()
+    assert np.isnan(f_bar).all()
