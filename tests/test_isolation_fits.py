@@ -285,3 +285,13 @@ def test_a_fit_that_divides_zero_by_zero_or_overflows_is_nan_quietly():
         f_bar, visible = predict(f_hat, K=(400.0, 0.0))
     assert visible[:, 0].all() and not visible[:, 1].any()
     assert np.isnan(f_bar).all()
+
+
+def test_the_weights_cap_at_e300_keeps_a_large_constant_estimate_predictable():
+    """Rate 400 /s over a 1 s window: the 25 samples 0.75 s or more before the window's end weigh e^300 (the cap),
+    so sum g^2 sum f_hat ~ 25 e^600 100 f = 5.6e307 for a constant f = 6e43, below the largest double (1.8e308): the
+    fit still returns f exactly (with a cap of e^301 the sum would overflow)."""
+    f_hat = np.full((len(T), 2), 6e43)
+    f_bar, visible = predict(f_hat, K=(400.0, 400.0))
+    assert visible.all()
+    np.testing.assert_allclose(f_bar[W - 1:], 6e43, rtol=1e-12)
