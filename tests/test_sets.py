@@ -385,11 +385,13 @@ def test_box_reductions_use_the_compiled_kernel_when_one_is_built(monkeypatch):
     calls = []
 
     def spy(*args, **kwargs):
-        calls.append(args[2])
+        calls.append((args[2], kwargs.get("details")))
         return kernel.box_reduce(*args, **kwargs)
 
     monkeypatch.setattr(reduction, "box_reduce", spy)
     Z = _random_zonotope(12, 3, 9)
     for method in ("girard", "combastel", "pca"):
         reduce(Z, 4, method)
-    assert calls == [False, True]  # combastel flag; PCA has no compiled path
+    reduce(Z, 4, coefficients=False)
+    # (combastel flag, whether the kernel returns the replaced mask for R); PCA has no compiled path
+    assert calls == [(False, True), (True, True), (False, False)]
