@@ -11,6 +11,8 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
   selected test reaches the code) and ``kill_rate`` = killed / (total - equivalent);
 - ``survivors``: name and diff of every survivor not justified as equivalent; ``stale_equivalents``: entries of
   the equivalents file whose mutant no longer exists or no longer shows the recorded change;
+  ``renumbered_equivalents``: entry -> the survivor it excused under another number (same function, and the
+  line the mutant adds is the entry's change: an edit above it renumbered the function's mutants);
 - ``started``, ``seconds``, ``modules_requested``, the mutmut version (``--merge`` keeps the other modules of
   the last results, each with the ``started`` of its own run).
 
@@ -163,14 +165,30 @@ def _dotted(module: str) -> str:
     return module[:-3].replace("/", ".") + "."
 
 
+def _function_of(mutant: str) -> str:
+    """uvsym.verify.exact.x_f__mutmut_12 -> uvsym.verify.exact.x_f (mutmut numbers mutants within a function)."""
+    return mutant.rsplit("__mutmut_", 1)[0]
+
+
+def _justifying(name: str, diff: str, equivalents: dict[str, dict]) -> str | None:
+    """The equivalents entry that excuses survivor ``name``: its own entry if the diff still shows the recorded
+    change, else an entry of the same function whose change is exactly the line the mutant adds (an edit above it
+    renumbers a function's mutants, not what they change)."""
+    entry = equivalents.get(name)
+    if entry and entry["change"].strip() in diff:
+        return name
+    added = {line[1:].strip() for line in diff.splitlines() if line.startswith("+")}
+    return next((e["mutant"] for e in equivalents.values()
+                 if _function_of(e["mutant"]) == _function_of(name) and e["change"].strip() in added), None)
+
+
 def _tally(scratch: Path, module: str, statuses: dict[str, str], equivalents: dict[str, dict],
-           started: str) -> tuple[dict, list[dict], set[str]]:
-    """(counts of one module, its unjustified survivors with their diffs, the equivalents that excused one)."""
-    survivors, excused = [], set()
+           started: str) -> tuple[dict, list[dict], dict[str, str]]:
+    """(counts of one module, its unjustified survivors with their diffs, survivor -> the entry that excused it)."""
+    survivors, excused = [], {}
     for name, diff in _diffs(scratch, [n for n, s in statuses.items() if s in ("survived", "no tests")]).items():
-        entry = equivalents.get(name)
-        if entry and entry["change"].strip() in diff:
-            excused.add(name)
+        if entry := _justifying(name, diff, equivalents):
+            excused[name] = entry
         else:
             survivors.append({"mutant": name, "module": module, "status": statuses[name], "diff": diff})
     count = {status: sum(s == status for s in statuses.values()) for status in set(statuses.values())}
@@ -246,7 +264,7 @@ def main(argv: list[str] | None = None) -> int:
         (scratch / "mutmut-run.log").write_text(run.stdout + run.stderr)
         seconds = time.perf_counter() - clock
         equivalents = {e["mutant"]: e for e in _equivalents()}
-        per_module, survivors, justified = {}, [], set()
+        per_module, survivors, justified = {}, [], {}
         outcomes = _outcomes(scratch, modules)
         for module, statuses in outcomes.items():
             per_module[module], left, excused = _tally(scratch, module, statuses, equivalents, started)
@@ -254,13 +272,14 @@ def main(argv: list[str] | None = None) -> int:
                                       tests_at=args.tests_at, tests_left_out=args.without,
                                       retested=sum(n.startswith(_dotted(module)) for n in names))
             survivors += left
-            justified |= excused
+            justified.update(excused)
     finally:
         if args.keep is None and args.again is None:
             shutil.rmtree(scratch, ignore_errors=True)
     measured = {name for statuses in outcomes.values() for name in statuses}
     prefixes = tuple(_dotted(m) for m in modules)
-    stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified)
+    stale = sorted(n for n in equivalents if n.startswith(prefixes) and n not in justified.values())
+    renumbered = {entry: name for name, entry in sorted(justified.items()) if entry != name}
     saved = json.loads(args.results.read_text()) if args.results.exists() else {}
     previous = saved.get("before") if args.before else saved
     if args.merge and previous and "modules" in previous:
@@ -273,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
                "tests_left_out": args.without, "tests_at": args.tests_at, "mutmut_exit_code": run.returncode,
                "mutants_measured": len(measured),
                "modules": per_module, "lowest_kill_rate": min(rates) if rates else None, "survivors": survivors,
-               "stale_equivalents": stale}
+               "stale_equivalents": stale, "renumbered_equivalents": renumbered}
     for module, m in per_module.items():
         rate = "-" if m["kill_rate"] is None else f"{100 * m['kill_rate']:.1f} %"
         print(f"{module:<40} {m['killed']:>4} of {m['total']:<4} killed ({rate}), {m['survived']} survived, "
