@@ -11,13 +11,20 @@ import uvsym
 from uvsym.cli import main
 
 
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "uvsym.cli", *args], capture_output=True, text=True, timeout=300)
-
-
-def test_version():
-    result = run("--version")
+def test_version_through_the_module_entry_point():
+    """The one test that starts ``python -m uvsym.cli`` in its own process (the others call ``main`` directly)."""
+    result = subprocess.run([sys.executable, "-m", "uvsym.cli", "--version"], capture_output=True, text=True,
+                            timeout=300)
     assert result.returncode == 0 and result.stdout.strip() == f"uvsym {uvsym.__version__}"
+
+
+def exit_status(capsys, *args) -> tuple[int, str]:
+    """``main(args)``'s exit status (argparse's SystemExit included) and what it wrote to stderr."""
+    try:
+        status = main(list(args))
+    except SystemExit as stop:
+        status = stop.code
+    return status, capsys.readouterr().err
 
 
 def test_models_json_lists_the_library(capsys):
@@ -55,10 +62,10 @@ def test_models_show_json(capsys):
 
 
 @pytest.mark.parametrize("args", [["models", "show", "nautilus"], ["models", "show"], ["report", "nonesuch"]])
-def test_unknown_names_exit_2_with_a_message(args):
-    result = run(*args)
-    assert result.returncode == 2
-    assert "uvsym: error:" in result.stderr and "Traceback" not in result.stderr
+def test_unknown_names_exit_2_with_a_message(args, capsys):
+    status, stderr = exit_status(capsys, *args)
+    assert status == 2
+    assert "uvsym: error:" in stderr and "Traceback" not in stderr
 
 
 def test_report_models_is_deterministic(tmp_path, built_report):
@@ -122,13 +129,13 @@ def test_simulate_writes_result_and_figure(tmp_path, capsys):
     assert (tmp_path / "run.svg").read_text().startswith("<?xml")
 
 
-def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path):
+def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path, capsys):
     scenario = tmp_path / "bad.toml"
     text = (Path(uvsym.__file__).parent / "sim" / "scenarios" / "docking_faults.toml").read_text()
     scenario.write_text(text.replace('kind = "bias"            # proportional', 'kind = "wobble"  #'))
-    result = run("simulate", str(scenario))
-    assert result.returncode == 2
-    assert "faults[0]" in result.stderr and "wobble" in result.stderr and "Traceback" not in result.stderr
+    status, stderr = exit_status(capsys, "simulate", str(scenario))
+    assert status == 2
+    assert "faults[0]" in stderr and "wobble" in stderr and "Traceback" not in stderr
 
 
 def test_codegen_writes_the_package_and_refuses_unknown_sets(tmp_path, capsys):
@@ -138,8 +145,8 @@ def test_codegen_writes_the_package_and_refuses_unknown_sets(tmp_path, capsys):
     assert manifest["precision"] == "double" and len(manifest["functions"]) == 7
     for path in ("Makefile", "CMakeLists.txt", "main.c", "harness.c", "include/uvsym_otter3dof_observers.h"):
         assert (tmp_path / "pkg" / path).exists(), path
-    result = run("codegen", "sliding-mode", "-o", str(tmp_path / "x"))
-    assert result.returncode == 2 and "unknown observer set" in result.stderr
+    status, stderr = exit_status(capsys, "codegen", "sliding-mode", "-o", str(tmp_path / "x"))
+    assert status == 2 and "unknown observer set" in stderr
 
 
 def _install(monkeypatch, **entries):
