@@ -177,3 +177,110 @@ def test_settings_say_whether_the_update_was_in_closed_form():
 def test_the_default_name_is_ukf():
     assert unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0).name == "ukf"
     assert ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0).name == "ukf"
+
+
+@pytest.mark.parametrize("beta", [float("inf"), float("-inf"), float("nan")])
+def test_a_beta_that_is_not_finite_is_refused_with_its_value(beta):
+    with pytest.raises(ObserverError, match=rf"^UKF beta must be a finite number, got {beta!r}$"):
+        unscented_weights(3, 1.0, beta, 0.0)
+
+
+@pytest.mark.parametrize("kappa", [-3.0, -3, -4.5, float("inf"), float("nan")])
+def test_a_kappa_with_n_plus_kappa_not_positive_or_not_finite_is_refused(kappa):
+    """n = 3: kappa = -3 is the boundary n + kappa = 0 (refused), -4.5 beyond it."""
+    message = rf"^UKF kappa must be finite with n \+ kappa > 0 \(n = 3\), got {kappa!r}$"
+    with pytest.raises(ObserverError, match=message):
+        unscented_weights(3, 1.0, 2.0, kappa)
+
+
+@pytest.mark.parametrize("kappa", [-2.5, 5.0])
+def test_a_kappa_just_above_minus_n_or_above_n_is_accepted(kappa):
+    """n = 3, alpha = 1: lambda = kappa, so w_i = 1 / (2 (3 + kappa)) and w_m0 = kappa / (3 + kappa)."""
+    scale, w_m, w_c = unscented_weights(3, 1.0, 2.0, kappa)
+    assert scale == pytest.approx(np.sqrt(3 + kappa))
+    np.testing.assert_allclose(w_m, [kappa / (3 + kappa)] + [1 / (2 * (3 + kappa))] * 6, rtol=1e-14)
+
+
+def test_passive_states_are_found_through_input_and_parameter_differences():
+    """a+ = a + (f - g) b, b+ = b + (k - c) c, c+ = c: b enters a's update and c enters b's (through
+    differences of two inputs and of two parameters), nothing reads a: order b, c, a."""
+    x = signals(("a", "m"), ("b", "m"), ("c", "m"), group="state")
+    plant = system("mix", "", x=x, u=signals(("f", "N"), ("g", "N"), group="input"),
+                   p=signals(("k", "-"), ("c", "-"), group="parameter"), p0=[1.0, 2.0], dt=0.1,
+                   rhs=lambda x, u, d, p: ca.vertcat(x[0] + (u[0] - u[1]) * x[1], x[1] + (p[0] - p[1]) * x[2], x[2]))
+    assert passive_last(plant, transition(plant, 0.1)) == [1, 2, 0]
+
+
+def scalar_plant(**options):
+    """x' = -x (continuous; 1/s), y = x: one input that nothing reads."""
+    return system("decay", "x' = -x", x=signals(("a", "m"), group="state"), u=signals(("f", "N"), group="input"),
+                  rhs=lambda x, u, d, p: -x, **options)
+
+
+@pytest.mark.parametrize("steps", [None, 2])
+def test_a_continuous_system_is_predicted_by_rk4_with_the_steps_asked(steps):
+    """Scalar Kalman filter by hand: K = P0 / (P0 + R), then x^- = g x, P^- = g^2 P + Q with the
+    RK4 factor g = 1 - h + h^2/2 - h^3/6 + h^4/24 of x' = -x per step of h = dt / steps (default 1);
+    rtol 1e-10 for the relative jitter of 1e-12 in the factorisations."""
+    dt, q, r, p0, x0, y = 0.5, 0.01, 0.2, 0.3, 1.0, 1.4
+    options = {} if steps is None else {"steps": steps}
+    obs = ukf(scalar_plant(), dt=dt, Q=q, R=r, P0=p0, x0=[x0], **options)
+    S, OUT = run_filter(obs, [[y]], [[0.0]])
+    k = steps or 1
+    h = dt / k
+    g = (1 - h + h**2 / 2 - h**3 / 6 + h**4 / 24) ** k
+    x_post, p_post = x0 + p0 / (p0 + r) * (y - x0), p0 * r / (p0 + r)
+    np.testing.assert_allclose(OUT[0, 0], x_post, rtol=1e-10)
+    np.testing.assert_allclose(S[1], [g * x_post, g**2 * p_post + q], rtol=1e-10)
+
+
+def test_the_closed_form_update_reports_no_factorisation_margin_of_its_own():
+    """Scalar linear filter: the closed-form update factorises nothing (margin 1 by convention) and
+    every relative pivot of a 1 x 1 factorisation is a (1 + jitter) / a >= 1: the margin is exactly 1."""
+    obs = ukf(scalar_plant(), dt=0.5, Q=0.01, R=0.2, P0=0.3, x0=[1.0])
+    OUT = run_filter(obs, [[1.4], [0.9]], [[0.0], [0.0]])[1]
+    assert OUT[:, obs.publishes.index("pd_margin")].tolist() == [1.0, 1.0]
+
+
+def test_the_sigma_point_update_of_a_square_law_sensor_matches_the_hand_transform():
+    """x+ = x, y = x^2, alpha = 1, beta = 2, kappa = 0 (n = 1): sigma points x, x +- s (s^2 = P),
+    weights w_m = (0, 1/2, 1/2), w_c = (2, 1/2, 1/2), so z = x^2 + P, P_zz = 2 P^2 + 4 x^2 P + R,
+    P_xz = 2 x P (negative for x < 0: the sign of the gain); rtol 1e-10 for the factorisations' jitter."""
+    square = system("square", "x+ = x, y = x^2", x=signals(("a", "m"), group="state"),
+                    u=signals(("f", "N"), group="input"), rhs=lambda x, u, d, p: x, dt=0.1,
+                    y=signals(("a2", "m2"), group="output"), output=lambda x, u, p: x**2)
+    q, r, p0, y = 0.01, 0.1, 0.5, 2.0
+    for x0 in (1.0, -1.0):
+        S, OUT = run_filter(ukf(square, dt=0.1, Q=q, R=r, P0=p0, x0=[x0]), [[y]], [[0.0]])
+        P_zz, P_xz = 2 * p0**2 + 4 * x0**2 * p0 + r, 2 * x0 * p0
+        x_post, p_post = x0 + P_xz / P_zz * (y - x0**2 - p0), p0 - P_xz**2 / P_zz
+        np.testing.assert_allclose(OUT[0, :2], [x_post, y - x0**2 - p0], rtol=1e-10)
+        np.testing.assert_allclose(S[1], [x_post, p_post + q], rtol=1e-10)
+
+
+def test_the_predicted_covariance_is_exactly_symmetric():
+    """P^- = sum w_c dX dX^T + Q is symmetric bit for bit (its upper triangle mirrors the lower)."""
+    filt = unscented_filter(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0)
+    x, L, u = ca.SX.sym("x", 3), ca.SX.sym("L", 3, 3), ca.SX.sym("u")
+    P = ca.mtimes(ca.tril(L), ca.tril(L).T)
+    predicted = ca.Function("predicted", [x, L, u], [filt.predict(x, P, u, ca.SX(0, 1))[1]])
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        M = np.asarray(predicted(rng.normal(size=3), rng.normal(size=(3, 3)) + 3 * np.eye(3), rng.normal()))
+        assert np.array_equal(M, M.T)
+
+
+def test_the_filter_records_its_method_noise_and_settings():
+    """Q and R given as variances are kept as the diagonal matrices (what banks of filters read)."""
+    filt = unscented_filter(scalar_plant(), dt=0.5, Q=[0.01], R=0.2, P0=0.3, steps=3)
+    assert filt.method == "ukf" and filt.settings["steps"] == 3
+    np.testing.assert_array_equal(filt.Q, [[0.01]])
+    np.testing.assert_array_equal(filt.R, [[0.2]])
+
+
+def test_the_description_gives_the_defaults_and_the_sample_period():
+    """Defaults of the scaled transform for a Gaussian prior: alpha = 1, beta = 2, kappa = 0."""
+    obs = ukf(scalar_plant(), dt=0.5, Q=0.01, R=0.2, P0=0.3)
+    assert obs.description == "UKF of decay (alpha 1, beta 2, kappa 0), sampled every 0.5 s"
+    assert ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, alpha=0.5, kappa=1.5).description == (
+        "UKF of linear (alpha 0.5, beta 2, kappa 1.5), sampled every 0.1 s")
