@@ -38,8 +38,9 @@ def _drop_residue(matrix: ca.SX, inputs: list, samples: int = 8, rtol: float = 1
     """``matrix`` without the entries that are rounding residue at every sampled input.
 
     Products such as ``M M^-1`` leave entries like ``1e-17 k tau`` that are zero in exact
-    arithmetic; an entry whose value stays below ``rtol`` times the matrix's largest at every
-    random sample is dropped (made structurally zero), so that a diagonal matrix is seen as one.
+    arithmetic; an entry whose value never exceeds ``rtol`` times the matrix's largest at
+    ``samples`` random inputs (every input drawn uniformly from [0.5, 2]) is dropped (made
+    structurally zero), so that a diagonal matrix is seen as one.
     """
     probe = ca.Function("probe", inputs, [matrix])
     rng = np.random.default_rng(0)
@@ -61,7 +62,11 @@ def _pieces(function: ca.Function) -> ca.Function:
     R = -function(ca.SX.zeros(n), eta, nu, tau_d, K)[1]
     phi = function(f_hat + R, eta, nu, tau_d, K)[0]
     inputs = [eta, nu, tau_d, K]
-    P = _drop_residue(ca.jacobian(phi, f_hat), inputs)
+    jac = ca.jacobian(phi, f_hat)
+    if ca.depends_on(jac, f_hat):
+        raise ObserverError(f"observer {function.name()}: x_dot must be affine in x (x_dot = P (x - R) + q), "
+                            "the sampled-data form needs it")
+    P = _drop_residue(jac, inputs)
     q = ca.substitute(phi, f_hat, ca.DM.zeros(n))
     L = _drop_residue(ca.jacobian(R, nu), inputs)
     return ca.Function("pieces", inputs, [P, q, L], ["eta", "nu", "tau_d", "K"], ["P", "q", "L"])
