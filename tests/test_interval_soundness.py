@@ -153,3 +153,48 @@ def test_true_cancelling_identities_agree_where_they_saturate():
             assert abs(lhs - rhs) <= 1e-12 * (1 + abs(rhs)), (x, lhs, rhs)
         lhs, rhs = (float(v) for v in f(-400.0))
         assert lhs == rhs == 2.0
+
+
+def test_a_seed_names_its_random_box():
+    """Each draw is U(a, b) = a + (b - a) r with r = random() of the stream (and N = standard_normal()):
+    zero width is N 10^U(-300, 300) at both ends, straddle sorts two U(-3, 3), any sorts two N 10^U(-320, 308)."""
+    for seed in range(6):
+        twin = np.random.default_rng(seed)
+        value = twin.standard_normal() * 10.0 ** (-300 + 600 * twin.random())
+        assert random_box(np.random.default_rng(seed), "zero width") == (value, value)
+        twin = np.random.default_rng(seed)
+        ends = sorted(-3 + 6 * twin.random() for _ in range(2))
+        assert random_box(np.random.default_rng(seed), "straddle") == tuple(ends)
+        twin = np.random.default_rng(seed)
+        ends = sorted(twin.standard_normal() * 10.0 ** (-320 + 628 * twin.random()) for _ in range(2))
+        assert random_box(np.random.default_rng(seed), "any") == tuple(ends)
+
+
+def test_sampled_points_of_finite_and_overflowing_boxes():
+    """[1, 2]: both ends and 4 points strictly inside (no 0); [-1e308, 1e308], whose width overflows to inf:
+    both ends, 2 points in (-1e308, 0), 2 in (0, 1e308) and 0, all finite."""
+    for seed in range(20):
+        points = enclosure_check._points(1.0, 2.0, np.random.default_rng(seed))
+        assert len(points) == 6 and points[:2] == [1.0, 2.0] and all(1 < p < 2 for p in points[2:])
+        points = enclosure_check._points(-1e308, 1e308, np.random.default_rng(seed))
+        assert len(points) == 7 and points[:2] == [-1e308, 1e308] and points[-1] == 0.0
+        assert all(-1e308 < p < 0 for p in points[2:4]) and all(0 < p < 1e308 for p in points[4:6])
+
+
+def test_points_outside_the_domain_are_each_reported_and_the_others_still_checked(monkeypatch):
+    """sqrt on [-1, 1] claimed defined in [5, 6]: each of the 7 x 7 points (7 per box, the second box padded
+    with (0, 0)) is a violation, outside the domain (x < 0) or below 5 (sqrt(x) <= 1)."""
+    monkeypatch.setattr(enclosure_check, "_interval_function", _fake_bounds(5.0, 6.0))
+    violations = enclosure_violations("sqrt", [(-1.0, 1.0)], np.random.default_rng(0))
+    assert len(violations) == 49
+    assert "sqrt on [(-1.0, 1.0), (0.0, 0.0)]: [-1.0, 0.0] is outside the domain, box defined" in violations
+    assert "sqrt on [(-1.0, 1.0), (0.0, 0.0)]: 1.0 at [1.0, 0.0] outside [5.0, 6.0]" in violations
+
+
+def test_the_oracle_works_with_203_bits(monkeypatch):
+    """60 digits are 203 bits in mpmath ((60 + 1) log2(10) rounded): 1 + 2^-200 is exact there and above a
+    claimed [1, 1], 1 + 2^-205 rounds to 1 (half an ulp of 1 is 2^-203) and passes."""
+    monkeypatch.setattr(enclosure_check, "_interval_function", _fake_bounds(1.0, 1.0))
+    for exponent, caught in ((-200, True), (-205, False)):
+        tiny = 2.0 ** exponent
+        assert bool(enclosure_violations("add", [(1.0, 1.0), (tiny, tiny)], np.random.default_rng(0))) is caught
