@@ -132,3 +132,12 @@ def test_actuator_fault_observer_refuses_zero_and_negative_gains(gains):
 def test_actuator_fault_observer_refuses_a_bad_name_as_an_observer_name():
     with pytest.raises(ObserverError, match=r"^observer name 'two words' must start with a letter"):
         actuator_fault_observer(uvsym.vehicle("otter3dof"), "bias", 0.05, [1, 2, 3], name="two words")
+
+
+def test_initial_state_is_a_float_vector_even_from_an_object_array():
+    """s0 = [f_hat = 0; P's non-zeros -K; q = tau_d; L's non-zeros 1; nu]; nu taken from a mixed-type table
+    arrives as an object array and must not make the state one."""
+    sampled = sampled_observer(_two_channel(), 0.1)
+    s0 = sampled.initial_state([0, 0], np.array([1.5, 2.0], dtype=object), [3.0, 4.0], [1.0, 2.0])
+    assert s0.dtype == np.float64
+    np.testing.assert_array_equal(s0, [0, 0, -1, -2, 3, 4, 1, 1, 1.5, 2])
