@@ -111,10 +111,8 @@ def sampled_observer(function: ca.Function, dt: float) -> SampledObserver:
     P, q, L = pieces(eta, nu, tau_d, K)
     rhs = f_prev + dt / 2 * (ca.mtimes(P_prev, f_prev) + q_prev + q) - ca.mtimes((L_prev + L) / 2, nu - nu_prev)
     lhs = ca.SX.eye(n) - dt / 2 * P
-    diagonal = set(zip(*sp_P.get_triplet())) <= {(i, i) for i in range(n)}
-    f_hat = rhs / ca.diag(lhs) if diagonal else ca.solve(lhs, rhs)
-    s_next = ca.densify(ca.vertcat(f_hat, ca.vertcat(ca.SX(0, 1), *P.nonzeros()), q,
-                                   ca.vertcat(ca.SX(0, 1), *L.nonzeros()), nu))
+    f_hat = ca.solve(lhs, rhs)  # on SX, a structurally diagonal lhs back-substitutes to rhs_i / lhs_ii
+    s_next = ca.densify(ca.vertcat(f_hat, *P.nonzeros(), q, *L.nonzeros(), nu))
     step = ca.Function("observer_step", [s, eta, nu, tau_d, K], [s_next, f_hat],
                        ["s", "eta", "nu", "tau_d", "K"], ["s_next", "f_hat"])
     return SampledObserver(step=step, pieces=pieces, n=n, nnz_P=nnz_P, nnz_L=nnz_L)
