@@ -2,6 +2,7 @@
 the first non-finite sample and the sizes it prints, with expected values worked out by hand."""
 
 import warnings
+from fractions import Fraction
 from types import SimpleNamespace
 
 import casadi as ca
@@ -50,13 +51,59 @@ def test_the_first_non_finite_entry_is_named_by_the_signal_that_holds_its_column
     assert run._first_non_finite(loop, np.array([0.0, 1.0, 2.0, 3.0, np.inf])) == "logged entry 4 (inf)"
 
 
-def test_a_correction_goes_to_its_columns_as_vec_s_column_by_column_then_o():
+@pytest.mark.parametrize("S, o", [
+    (np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([5.0, 6.0])),
+    ([[1, 2], [3, 4]], [5, 6]),  # integers, nested lists
+    (np.array([[1, 2], [3, 4]], np.uint8), np.array([5, 6], np.longdouble)),  # any real dtype
+])
+def test_a_correction_goes_to_its_columns_as_vec_s_column_by_column_then_o(S, o):
     """S = [[1, 2], [3, 4]]: vec(S) stacks the columns, (1, 3, 2, 4), then o = (5, 6)."""
     loop = SimpleNamespace(correction_columns=slice(3, 9), substitution_columns={})
-    columns, values = run._decision_columns(loop, Correction(np.array([[1, 2], [3, 4]]), np.array([5, 6])))
+    columns, values = run._decision_columns(loop, Correction(S, o))
     assert columns == slice(3, 9)
     np.testing.assert_array_equal(values, [1.0, 3.0, 2.0, 4.0, 5.0, 6.0])
-    assert values.dtype == np.float64
+
+
+def test_a_correction_of_one_command_may_be_boolean():
+    """m = 1 takes 1 (1 + 1) = 2 columns: S = [[True]] is 1, o = [False] is 0."""
+    loop = SimpleNamespace(correction_columns=slice(4, 6))
+    np.testing.assert_array_equal(run._decision_columns(loop, Correction(np.array([[True]]), np.array([False])))[1],
+                                  [1.0, 0.0])
+
+
+@pytest.mark.parametrize("S, o, dtypes", [
+    (np.eye(2) + 1j, np.zeros(2), "complex128 S and float64 o"),  # refused, not truncated to its real part
+    (np.eye(2), [1j, 0.0], "float64 S and complex128 o"),
+    (np.eye(2), ["1", "0"], "float64 S and <U1 o"),
+    ([[Fraction(1, 2), 0], [0, 1]], np.zeros(2), "object S and float64 o"),
+])
+def test_a_correction_that_is_not_real_numbers_is_refused_with_its_types(S, o, dtypes):
+    loop = SimpleNamespace(correction_columns=slice(3, 9), substitution_columns={})
+    with pytest.raises(SimulationError) as caught:
+        run._decision_columns(loop, Correction(S, o))
+    assert str(caught.value) == f"supervisor returned a Correction of {dtypes}; it takes real numbers"
+
+
+def test_a_ragged_correction_is_refused():
+    loop = SimpleNamespace(correction_columns=slice(3, 9), substitution_columns={})
+    with pytest.raises(SimulationError, match=r"^supervisor returned a Correction that is not two arrays: \S"):
+        run._decision_columns(loop, Correction([[1.0, 2.0], [3.0]], np.zeros(2)))
+
+
+@pytest.mark.parametrize("S, o, shapes", [
+    (np.eye(3), np.zeros(3), "S (3, 3) and o (3,)"),  # a 3-command correction for 2 commands: 12 values, not 6
+    (np.arange(4.0), np.zeros(2), "S (4,) and o (2,)"),  # 6 values, but S is no matrix
+    (np.ones((1, 4)), np.zeros(2), "S (1, 4) and o (2,)"),  # 6 values, S not square
+    (np.eye(2), np.zeros((2, 1)), "S (2, 2) and o (2, 1)"),  # 6 values, o not a vector
+    (np.eye(2), np.zeros(3), "S (2, 2) and o (3,)"),  # 7 values
+])
+def test_a_correction_of_the_wrong_shape_is_refused_with_both_shapes_and_the_loops_width(S, o, shapes):
+    """The loop's 6 correction columns take m = 2 commands: S (2, 2), o (2,), 2 (2 + 1) = 6."""
+    loop = SimpleNamespace(correction_columns=slice(3, 9), substitution_columns={})
+    with pytest.raises(SimulationError) as caught:
+        run._decision_columns(loop, Correction(S, o))
+    assert str(caught.value) == (f"supervisor returned a Correction with {shapes}; this loop takes S (m, m) and o (m,) "
+                                 "with m (m + 1) = 6")
 
 
 def test_a_substitution_switches_its_channels_on_and_every_other_off():

@@ -141,8 +141,18 @@ def _first_non_finite(loop: SampledLoop, row: np.ndarray) -> str:
 def _decision_columns(loop: SampledLoop, decision) -> tuple[slice | list[int], np.ndarray]:
     """Where in w a supervisor's decision goes and its values; SimulationError for one the loop cannot take."""
     if isinstance(decision, Correction) and loop.correction_columns is not None:
-        return loop.correction_columns, np.concatenate([np.asarray(decision.S, float).reshape(-1, order="F"),
-                                                        np.asarray(decision.o, float)])
+        width = loop.correction_columns.stop - loop.correction_columns.start  # m (m + 1): vec(S), then o
+        try:
+            S, o = np.asarray(decision.S), np.asarray(decision.o)
+        except ValueError as exc:  # ragged nesting
+            raise SimulationError(f"supervisor returned a Correction that is not two arrays: {exc}") from None
+        if not all(np.can_cast(a.dtype, float, "same_kind") for a in (S, o)):  # not complex: no imaginary part lost
+            raise SimulationError(f"supervisor returned a Correction of {S.dtype} S and {o.dtype} o; it takes real "
+                                  "numbers")
+        if S.shape != (o.size, o.size) or o.shape != (o.size,) or S.size + o.size != width:
+            raise SimulationError(f"supervisor returned a Correction with S {S.shape} and o {o.shape}; this loop takes "
+                                  f"S (m, m) and o (m,) with m (m + 1) = {width}")
+        return loop.correction_columns, np.concatenate([S.reshape(-1, order="F"), o])
     if isinstance(decision, Substitution):
         channels = loop.substitution_columns
         unknown = sorted(decision.channels - set(channels))
