@@ -185,3 +185,55 @@ def test_actuator_fault_observer_refuses_gains_that_are_not_numbers_and_reads_de
     obs = actuator_fault_observer(model, "bias", 0.05, [1.0, 2.0, 3.0])
     assert obs.reads_u.names == ("tau_d.X", "tau_d.Y", "tau_d.N")
     assert obs.reads_u.group == "desired force"
+
+
+def _held_sum_observer():
+    """s_next = g s + u, out = s (y unread, so a missing sample cannot spoil it); init = (y1 + g, y2 + c)."""
+    return observer("avg2", step=lambda s, y, u, p: (p[0] * s + u[0], s), state=signals(("a", "-"), ("b", "-")),
+                    reads_y=signals(("y1", "-"), ("y2", "-")), reads_u=signals(("c", "-")),
+                    params=signals(("g", "-")), p0=[1.0], publishes=signals(("a_out", "-"), ("b_out", "-")), dt=0.1,
+                    init=lambda y0, u0, p: [y0[0] + p[0], y0[1] + u0[0]])
+
+
+def test_run_starts_from_the_first_complete_measurement_with_the_given_parameters():
+    obs = _held_sum_observer()
+    # sample 0 misses y1 (None reads as NaN), sample 1 is complete: s0 = (2 + g, 3 + U[0]) with g = 2 -> (4, 13);
+    # then s_{k+1} = 2 s_k + u_k by hand
+    S, out = obs.run([[None, 1.0], [2.0, 3.0], [None, None]], [[10.0], [0.0], [0.0]], p=[2.0], missing_y=True)
+    np.testing.assert_array_equal(S, [[4.0, 13.0], [18.0, 36.0], [36.0, 72.0], [72.0, 144.0]])
+    np.testing.assert_array_equal(out, S[:3])
+    # no complete sample: the first one, its NaN as zero, with p0: s0 = (0 + 1, 5 + 0), held (g = 1, u = 0)
+    S, _ = obs.run([[np.nan, 5.0], [np.nan, 7.0]], np.zeros((2, 1)), missing_y=True)
+    np.testing.assert_array_equal(S, [[1.0, 5.0]] * 3)
+    S, _ = obs.run([[np.nan, np.nan]], [[2.0]], missing_y=True)
+    np.testing.assert_array_equal(S, [[1.0, 2.0], [3.0, 4.0]])
+    # None where a number is due is refused like NaN, not passed on as an object
+    with pytest.raises(ObserverError, match="measurements Y finite$"):
+        obs.run([[None, 1.0], [2.0, 3.0]], np.zeros((2, 1)))
+    with pytest.raises(ObserverError, match="inputs U must be finite"):
+        obs.run(np.zeros((2, 2)), [[0.0], [None]])
+
+
+def test_run_refuses_mismatched_samples_and_takes_a_single_one():
+    obs = _held_sum_observer()
+    message = r"^avg2: measurements Y must be \(N, 2\) \(y1, y2\) and inputs U \(N, 1\), at least one sample; got "
+    with pytest.raises(ObserverError, match=message + r"\(3, 2\) and \(2, 1\)$"):
+        obs.run(np.zeros((3, 2)), np.zeros((2, 1)))
+    with pytest.raises(ObserverError, match=message + r"\(3, 2\) and \(3, 2\)$"):
+        obs.run(np.zeros((3, 2)), np.zeros((3, 2)))
+    with pytest.raises(ObserverError, match=message + r"\(0, 2\) and \(0, 1\)$"):
+        obs.run(np.zeros((0, 2)), np.zeros((0, 1)))
+    # one sample: s0 = (1 + 1, 2 + 3), s1 = s0 + 3
+    S, out = obs.run([[1.0, 2.0]], [[3.0]])
+    np.testing.assert_array_equal(S, [[2.0, 5.0], [5.0, 8.0]])
+    np.testing.assert_array_equal(out, [[2.0, 5.0]])
+
+
+def test_run_takes_a_given_initial_state_of_any_shape_and_refuses_a_bad_one():
+    obs = _held_sum_observer()
+    S, _ = obs.run(np.zeros((2, 2)), [[1.0], [-1.0]], s0=[[1.0], [2.0]])  # a column is read as the state vector
+    np.testing.assert_array_equal(S, [[1.0, 2.0], [2.0, 3.0], [1.0, 2.0]])
+    with pytest.raises(ObserverError, match=r"^avg2: s0 must be 2 finite values, got 3$"):
+        obs.run(np.zeros((2, 2)), np.zeros((2, 1)), s0=[1.0, 2.0, 3.0])
+    with pytest.raises(ObserverError, match=r"^avg2: s0 must be 2 finite values, got 2$"):
+        obs.run(np.zeros((2, 2)), np.zeros((2, 1)), s0=[None, 1.0])
