@@ -127,6 +127,11 @@ def test_a_decision_the_loop_cannot_apply_names_the_kind_it_expects():
     with pytest.raises(SimulationError) as caught:
         run._decision_columns(corrects, "stop")
     assert str(caught.value) == "supervisor returned str, which this loop cannot apply; expected Correction or None"
+    switches = SimpleNamespace(correction_columns=None, substitution_columns={"q": 4})
+    with pytest.raises(SimulationError) as caught:
+        run._decision_columns(switches, Correction(np.eye(1), np.zeros(1)))
+    assert str(caught.value) == ("supervisor returned Correction, which this loop cannot apply; expected Substitution "
+                                 "or None")
 
 
 def _fake_compiler(monkeypatch, compiler, roll):
