@@ -3,6 +3,7 @@ the first non-finite sample and the sizes it prints, with expected values worked
 
 import warnings
 from fractions import Fraction
+from pathlib import Path
 from types import SimpleNamespace
 
 import casadi as ca
@@ -189,7 +190,8 @@ def test_a_failed_compilation_warns_at_the_runs_caller_and_runs_interpreted(monk
         warnings.simplefilter("always")
         result, _ = run.run_closed_loop(_counter(), np.zeros(1), np.zeros((4, 1)))
     assert [str(w.message) for w in caught] == ["running the fast path interpreted: no room for the library"]
-    assert caught[0].category is UserWarning and caught[0].filename == __file__
+    # at the caller, not inside the runner (the caller is this file, or a wrapper a mutation tool adds)
+    assert caught[0].category is UserWarning and Path(caught[0].filename).resolve() != Path(run.__file__).resolve()
     np.testing.assert_array_equal(result.signals["z"].values[:, 0], [0.0, 1.0, 2.0, 3.0])
 
 
