@@ -18,7 +18,7 @@ SEED, COUNT = 18, 900
 FUNCTIONS = {"sin": math.sin, "tanh": math.tanh, "expm1": math.expm1}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture  # per test, not per module: a mutation tool links a function to the tests whose set-up called it
 def cases():
     return region_cases(COUNT, seed=SEED)
 

@@ -92,7 +92,7 @@ def test_residue_probe_draws_inputs_from_half_to_two_reproducibly():
     assert _drop_residue(partial, [a], samples=8).sparsity().get_triplet() == first
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture  # per test, not per module: a mutation tool links a function to the tests whose set-up called it
 def otter_bias():
     return uvsym.vehicle("otter3dof"), actuator_fault_observer(uvsym.vehicle("otter3dof"), "bias", 0.05, [1, 2, 3])
 
