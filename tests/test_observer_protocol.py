@@ -187,12 +187,12 @@ def test_actuator_fault_observer_refuses_gains_that_are_not_numbers_and_reads_de
     assert obs.reads_u.group == "desired force"
 
 
-def _held_sum_observer():
+def _held_sum_observer(init=lambda y0, u0, p: [y0[0] + p[0], y0[1] + u0[0]]):
     """s_next = g s + u, out = s (y unread, so a missing sample cannot spoil it); init = (y1 + g, y2 + c)."""
     return observer("avg2", step=lambda s, y, u, p: (p[0] * s + u[0], s), state=signals(("a", "-"), ("b", "-")),
                     reads_y=signals(("y1", "-"), ("y2", "-")), reads_u=signals(("c", "-")),
                     params=signals(("g", "-")), p0=[1.0], publishes=signals(("a_out", "-"), ("b_out", "-")), dt=0.1,
-                    init=lambda y0, u0, p: [y0[0] + p[0], y0[1] + u0[0]])
+                    init=init)
 
 
 def test_run_starts_from_the_first_complete_measurement_with_the_given_parameters():
@@ -237,3 +237,23 @@ def test_run_takes_a_given_initial_state_of_any_shape_and_refuses_a_bad_one():
         obs.run(np.zeros((2, 2)), np.zeros((2, 1)), s0=[1.0, 2.0, 3.0])
     with pytest.raises(ObserverError, match=r"^avg2: s0 must be 2 finite values, got 2$"):
         obs.run(np.zeros((2, 2)), np.zeros((2, 1)), s0=[None, 1.0])
+
+
+def test_initial_state_names_the_observer_and_takes_any_shape_of_init_as_floats():
+    obs = _held_sum_observer()
+    with pytest.raises(ObserverError) as refused:
+        obs.initial_state([1.0], [0.0])
+    assert str(refused.value) == "avg2: y0 must have 2 entries (y1, y2), got 1"
+    # init's (2, 1) column of integers is the state vector of floats: (y1 + g, y2 + c) = (1 + 1, 2 + 3)
+    column = _held_sum_observer(lambda y0, u0, p: [[int(y0[0] + p[0])], [int(y0[1] + u0[0])]])
+    s0 = column.initial_state([1.0, 2.0], [3.0])
+    assert s0.shape == (2,) and s0.dtype == np.float64 and s0.tolist() == [2.0, 5.0]
+
+
+@pytest.mark.parametrize("init, size, finite", [(lambda y0, u0, p: [1.0, 2.0, 3.0], 3, True),
+                                                 (lambda y0, u0, p: [1.0, np.nan], 2, False),
+                                                 (lambda y0, u0, p: [np.inf], 1, False)])
+def test_initial_state_refuses_an_init_of_the_wrong_size_or_not_finite(init, size, finite):
+    with pytest.raises(ObserverError) as refused:
+        _held_sum_observer(init).initial_state([1.0, 2.0], [3.0])
+    assert str(refused.value) == f"avg2: init gave {size} entries (finite: {finite}), expected 2 finite"
