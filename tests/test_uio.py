@@ -535,3 +535,78 @@ def test_observer_groups_are_its_own_and_sizes_and_prior_are_named():
                      inputs=_group("u", 2, "input"), dt=H)
     with pytest.raises(ModelError, match=r"^uio: prior must have 3 entries \(x0, x1, x2\), got 2$"):
         _small_observer(prior=[1.0, 2.0])
+
+
+# --- exact elimination helpers and claim fields (vuio1) ---
+
+def test_row_echelon_is_reduced_exactly_and_skips_zero_columns():
+    """By hand: [[1, 1], [1, 2]] and [[1, 1], [0, 1]] reduce to I; I3 stays I3; [[0, 1], [0, 2]] has its pivot in
+    column 1; an empty matrix has no pivots."""
+    from uvsym.verify.uio import _row_echelon
+    one, eye2 = Fraction(1), [[Fraction(1), Fraction(0)], [Fraction(0), Fraction(1)]]
+    assert _row_echelon([[one, one], [one, 2 * one]]) == (eye2, [0, 1])
+    assert _row_echelon([[one, one], [0 * one, one]]) == (eye2, [0, 1])
+    eye3 = [[Fraction(int(i == j)) for j in range(3)] for i in range(3)]
+    assert _row_echelon(eye3) == (eye3, [0, 1, 2])
+    assert _row_echelon([[0 * one, one], [0 * one, 2 * one]]) == ([[0, 1], [0, 0]], [1])
+    assert _row_echelon([]) == ([], [])
+
+
+def test_null_vector_is_in_the_kernel_exactly():
+    """A v = 0 checked in rationals for a kernel of dimension 1 ([[1, 1]]) and 2 ([[1, 1, 1]])."""
+    from uvsym.verify.uio import _null_vector
+    for A in ([[Fraction(1), Fraction(1)]], [[Fraction(1), Fraction(1), Fraction(1)]]):
+        v = _null_vector(A)
+        assert any(v) and all(sum(a * b for a, b in zip(row, v)) == 0 for row in A)
+
+
+def test_singular_inverse_and_non_nilpotent_zoh_are_named():
+    from uvsym.errors import VerificationError
+    from uvsym.verify.uio import _inverse
+    with pytest.raises(VerificationError, match=r"^matrix is singular$"):
+        _inverse([[Fraction(1), Fraction(2)], [Fraction(2), Fraction(4)]])
+    with pytest.raises(VerificationError, match=r"^exact_zoh needs \[\[A, B\], \[0, 0\]\] nilpotent \(a chain of "
+                                                r"integrators\); it is not$"):
+        exact_zoh([[1.0]], [[0.0]], 0.1)
+
+
+def test_claim_shapes_and_column_rank_are_named():
+    from uvsym.errors import VerificationError
+    with pytest.raises(VerificationError, match=r"^G must be \(n, n\), C \(p, n\), D \(n, q\); got 2x2, 1x3, 2x1$"):
+        uio_existence_claim("C wide", np.eye(2), [[1.0, 0.0, 0.0]], [[0.0], [1.0]])
+    with pytest.raises(VerificationError, match=r"^G must be \(n, n\), C \(p, n\), D \(n, q\); got 2x3, 1x2, 2x1$"):
+        uio_existence_claim("G wide", np.ones((2, 3)), [[1.0, 0.0]], [[0.0], [1.0]])
+    # D = [[1, 2], [0, 0]] has rank 1 < 2 columns; C = I keeps rank(C D) = 1
+    with pytest.raises(VerificationError, match=r"^D must have full column rank \(2\), it has rank 1$"):
+        uio_existence_claim("rank", np.eye(2), np.eye(2), [[1.0, 2.0], [0.0, 0.0]])
+
+
+def test_rank_refutation_states_claim_status_margin_method_and_time():
+    """C D = 0 but rank D = 1: margin rank(C D) - rank(D) = -1; expected left at its default "proved"."""
+    refuted = uio_existence_claim("C D = 0", np.eye(2) * 0.5, [[0.0, 1.0]], [[1.0], [0.0]])
+    assert (refuted.claim, refuted.status, refuted.expected) == ("C D = 0", "refuted", "proved")
+    assert refuted.method == "exact rank (fraction elimination)" and refuted.margin == -1.0
+    assert refuted.seconds > 0.0
+    assert uio_existence_claim("C D = 0", np.eye(2) * 0.5, [[0.0, 1.0]], [[1.0], [0.0]],
+                               expected="refuted").expected == "refuted"
+    stuck = uio_existence_claim("no gain", np.diag([1.5, 0.5]), np.eye(2), [[0.0], [1.0]], K1=np.zeros((2, 2)),
+                                expected="inconclusive")
+    assert stuck.method == "exact rank; Lyapunov and PBH searches"
+
+
+def test_a_complex_pair_does_not_hide_a_later_real_unobservable_eigenvalue():
+    """G = blockdiag(rotation by 90 deg scaled 2, 2, 0.5), D = e4, C = e4^T: T = diag(1, 1, 1, 0), the pair +-2j
+    (listed first) is skipped and the real eigenvalue 2 with v = e3 (C v = 0) refutes."""
+    G = np.array([[0.0, -2.0, 0.0, 0.0], [2.0, 0.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0], [0.0, 0.0, 0.0, 0.5]])
+    claim = uio_existence_claim("pair first", G, [[0.0, 0.0, 0.0, 1.0]], [[0.0], [0.0], [0.0], [1.0]],
+                                expected="refuted")
+    assert claim.status == "refuted"
+    assert claim.counterexample["unobservable_eigenvalue"] == 2.0
+    assert claim.counterexample["eigenvector"] == [0.0, 0.0, 1.0, 0.0]
+
+
+def test_an_eigenvalue_with_a_denominator_above_1000_is_not_rounded_onto():
+    """G1 = diag(1002/1001, 0) exactly, e1 unobservable: the nearest rational with denominator <= 1000 is not an
+    eigenvalue, so no exact eigenvector is found (the search stops at denominators of 1000)."""
+    G = [[Fraction(1002, 1001), Fraction(0)], [Fraction(0), Fraction(1, 2)]]
+    assert uio_existence_claim("1002/1001", G, [[0, 1]], [[0], [1]], expected="inconclusive").status == "inconclusive"
