@@ -610,3 +610,15 @@ def test_an_eigenvalue_with_a_denominator_above_1000_is_not_rounded_onto():
     eigenvalue, so no exact eigenvector is found (the search stops at denominators of 1000)."""
     G = [[Fraction(1002, 1001), Fraction(0)], [Fraction(0), Fraction(1, 2)]]
     assert uio_existence_claim("1002/1001", G, [[0, 1]], [[0], [1]], expected="inconclusive").status == "inconclusive"
+
+
+def test_a_defective_unobservable_eigenvalue_split_by_rounding_is_refuted():
+    """G = blockdiag([[4, 9], [-1, -2]], 0.5): trace 2, determinant 1, so the block is a Jordan block at 1 (not
+    diagonalisable); LAPACK returns 1 +- 2.7e-8 j. D = e3, C = e3^T: the exact eigenvector (-3, 1, 0) of G1 has
+    C v = 0, so the claim is refuted at lambda = 1."""
+    G = np.array([[4.0, 9.0, 0.0], [-1.0, -2.0, 0.0], [0.0, 0.0, 0.5]])
+    assert min(abs(lam.imag) for lam in np.linalg.eigvals(G[:2, :2])) > 1e-9  # the premise: a split pair
+    claim = uio_existence_claim("Jordan block", G, [[0.0, 0.0, 1.0]], [[0.0], [0.0], [1.0]], expected="refuted")
+    assert claim.status == "refuted" and claim.counterexample["unobservable_eigenvalue"] == 1.0
+    v = claim.counterexample["eigenvector"]
+    assert v[2] == 0.0 and v[0] == -3 * v[1] != 0.0

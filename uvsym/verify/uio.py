@@ -8,9 +8,11 @@ double entries of G, C, D (and of a gain K1) are taken as the exact rationals th
 2. with a gain K1: ``F = G1 - K1 C`` is shown Schur stable by a discrete Lyapunov certificate,
    ``X > 0`` and ``X - F^T X F > 0`` by exact LDL^T (X from scipy, rounded to rationals), which
    proves ``(C, G1)`` detectable and the observer's error ``e+ = F e`` convergent: **proved**;
-3. otherwise an eigenvalue of G1 with ``|lambda| >= 1`` that the PBH test finds unobservable is
-   rounded to a nearby simple rational ``lambda*``, and a vector v with ``G1 v = lambda* v`` and
-   ``C v = 0`` is computed and checked in rationals: **refuted**, with lambda* and v as evidence.
+3. otherwise the real part of each eigenvalue of G1 with ``|lambda| >= 1`` that the PBH test finds
+   unobservable (also of a complex one: rounding splits a defective real eigenvalue into a pair with an
+   imaginary part near 1e-8) is rounded to a nearby simple rational ``lambda*``, and a vector v with
+   ``G1 v = lambda* v`` and ``C v = 0`` is computed and checked in rationals: **refuted**, with lambda*
+   and v as evidence.
 
 :func:`exact_zoh` samples a continuous model exactly when its augmented matrix is nilpotent (a
 chain of integrators, such as a rigid body linearised at rest), so that structural eigenvalues
@@ -160,8 +162,6 @@ def uio_existence_claim(claim: str, G, C, D, K1=None, set_description: str = "",
                         details={"rank_CD": rank_CD, "spectral_radius_F": float(max(abs(np.linalg.eigvals(F_float))))})
     G1_float = np.array([[float(v) for v in row] for row in G1])
     for lam in unobservable_modes(G1_float, np.array([[float(v) for v in row] for row in C])):
-        if abs(lam.imag) > 1e-9:
-            continue
         candidate = Fraction(lam.real).limit_denominator(1000)
         v = _null_vector(_sub(G1, _eye(n, candidate)) + C)
         if v is not None and abs(candidate) >= 1:
