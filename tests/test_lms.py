@@ -514,3 +514,34 @@ def test_step_claim_takes_a_column_of_samples_and_states_its_set_bound_and_expec
     assert certificate.details["bound"] == 0.25  # 1 / (M P_u) = 1 / 4
     assert certificate.set == "the recorded input (2 samples, P_u = 2), M = 2"
     assert 0.0 < certificate.seconds <= elapsed  # its own duration, measured around the call
+
+
+# --- samp1: mutation survivors of uvsym.observers.lms_supervisor ---
+
+
+def test_double_criterion_names_its_inputs_outputs_and_state_symbols():
+    decide = double_criterion(3)
+    assert decide.name_in() == ["d", "a_e", "a_R"] and decide.name_out() == ["d_next", "snapshot", "released"]
+    assert str(decide.sx_in(0)) == "[d_0, d_1, d_2]"  # the state symbol is d (3,), as documented
+
+
+def test_R_alarm_exactly_confirm_samples_after_the_freeze_still_confirms_the_fault():
+    # confirm = 3: freeze at sample 1 (age 0); R fires at sample 4, age 3 = confirm, the last sample allowed
+    rows = decide_sequence([0, 1, 0, 0, 0, 0], [0, 0, 0, 0, 1, 0])
+    assert list(rows[:, 1]) == [0, 0, 1, 2, 3, 4]  # age counts samples since the eps2 alarm
+    assert list(rows[:, 2]) == [0, 0, 0, 0, 1, 1]  # confirmed at age 3 and latched
+    assert not rows[:, 4].any()  # so never released as a disturbance
+
+
+def test_supervisor_logs_the_switch_back_and_first_is_none_for_an_absent_event():
+    obs = monitor(M=2)
+    names = obs.publishes.names
+    supervisor = SubstitutionSupervisor(obs, substitute_on="alarm")
+    assert supervisor.first("substitution") is None  # an empty log
+    for k, (frozen, released) in enumerate(((1, 0), (0, 1))):
+        flags = np.zeros((1, len(names)))
+        flags[0, names.index("frozen_y")], flags[0, names.index("disturbance_y")] = frozen, released
+        supervisor.update(np.array([0.1 * k]), {obs.name: flags})
+    assert [e.what for e in supervisor.events if e.what.startswith("substitution")] == [
+        "substitution on from the next sample", "substitution off from the next sample"]
+    assert supervisor.first("R alarm") is None  # no fault was confirmed
