@@ -330,3 +330,25 @@ def test_build_files_manifest_names_and_layout_follow_the_package_name(tmp_path)
     assert "int pkg_casadi_twice(" in (tmp_path / "src" / "pkg_casadi.c").read_text()  # the name the manifest gives
     # sorted top-level keys start with "casadi" (the version); nested keys one level deeper by two more spaces
     assert text.startswith('{\n  "casadi": "') and '\n    "PKG_OK": {\n      "meaning": ' in text
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_a_renamed_sx_function_stays_an_sx_graph():
+    from uvsym.codegen.package import _renamed
+    x = ca.SX.sym("x", 2)
+    renamed = _renamed(ca.Function("f", [x], [x[0] * x[1]], ["x"], ["y"]), "g")
+    assert renamed.is_a("SXFunction") and renamed.name() == "g" and float(renamed([2.0, 3.0])) == 6.0
+
+
+def test_the_header_comment_is_one_line_per_entry_before_the_prototype(tmp_path):
+    x = ca.SX.sym("x", 2)
+    function = ca.Function("halve", [x], [x / 2], ["x"], ["y"])
+    write_package(tmp_path, [Exported(function, (Entries("x", ("a", "b"), ("m", "m")),), ("y (m)",), "halve")],
+                  "tiny")
+    expected = ("/* halve\n *\n * in  x[2]: x\n *       [0] a [m]\n *       [1] b [m]\n * out y[2]: y (m)\n"
+                " * Returns TINY_OK, TINY_EVAL_FAILED, TINY_NONFINITE_INPUT or TINY_NONFINITE_OUTPUT.\n"
+                " * Uses static work buffers: not reentrant. */\n"
+                "int tiny_halve(const tiny_real x[2], tiny_real y[2]);\n")
+    assert expected in (tmp_path / "include" / "tiny.h").read_text()

@@ -284,3 +284,31 @@ def test_the_description_gives_the_defaults_and_the_sample_period():
     assert obs.description == "UKF of decay (alpha 1, beta 2, kappa 0), sampled every 0.5 s"
     assert ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, alpha=0.5, kappa=1.5).description == (
         "UKF of linear (alpha 0.5, beta 2, kappa 1.5), sampled every 0.1 s")
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_the_factor_of_an_indefinite_matrix_is_the_documented_diagonal_fallback():
+    from uvsym.observers.kalman import cholesky
+    factor, margin = cholesky(ca.SX(ca.DM([[1.0, 2.0], [2.0, 1.0]])))  # eigenvalues 3 and -1
+    # fallback diag(sqrt(|a_jj| + 1)) = sqrt(2) I; second pivot 1 - 4 < 0, so the margin is clipped at -1
+    np.testing.assert_allclose(np.array(ca.evalf(ca.densify(factor))), np.sqrt(2.0) * np.eye(2), rtol=1e-12)
+    assert float(ca.evalf(margin)) == -1.0
+
+
+def test_covariance_units_drop_dimensionless_factors():
+    from uvsym.observers.kalman import covariance_signals
+    P = covariance_signals(signals(("c", "-"), ("a", "m"), group="state"))
+    assert P.names == ("P.c.c", "P.a.c", "P.a.a") and P.units == ("-", "m", "m m")
+
+
+def test_the_efficiency_augmented_system_describes_itself_and_names_its_parameters():
+    from uvsym.observers.kalman import efficiency_augmented
+    plant = linear_plant()
+    augmented = efficiency_augmented(plant, ("f",))
+    assert augmented.description == "x+ = A x + B u, y = C x; efficiencies of f as random-walk states"
+    gain = system("gain", "x' = -k x + f", x=signals(("a", "m"), group="state"), u=signals(("f", "m/s"), group="input"),
+                  p=signals(("k", "1/s"), group="parameter"), rhs=lambda x, u, d, p: -p * x + u, p0=[1.0])
+    f = efficiency_augmented(gain, ("f",)).f  # symbols named as the arguments, as printed in its expressions
+    assert [str(f.sx_in(i)) for i in range(4)] == ["[x_0, x_1]", "u", "0x1", "p"]
