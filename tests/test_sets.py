@@ -395,3 +395,27 @@ def test_box_reductions_use_the_compiled_kernel_when_one_is_built(monkeypatch):
     reduce(Z, 4, coefficients=False)
     # (combastel flag, whether the kernel returns the replaced mask for R); PCA has no compiled path
     assert calls == [(False, True), (True, True), (False, False)]
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_a_hull_radius_exactly_at_the_growth_limit_is_accepted():
+    """Step 0 of |x0| <= 1: hull radius 1 = exact radius 1; the guard raises only for MORE than
+    growth_limit * exact + 1e-12 max(exact), here (1 - 1e-12) + 1e-12 == 1.0 exactly in floats."""
+    limit = 1.0 - 1e-12
+    assert limit + 1e-12 == 1.0
+    result = propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 1, 2, growth_limit=limit)
+    assert result.upper[0, 0] == 1.0
+    with pytest.raises(SetDivergenceError):
+        propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 1, 2, growth_limit=limit - 1e-12)
+
+
+def test_carried_noise_coefficients_accept_any_real_numbers():
+    from decimal import Decimal
+
+    result = propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 3, 2)
+    eta = np.full((3, 1, 1), 0.5)
+    decimals = [[[Decimal("0.5")]]] * 3
+    np.testing.assert_array_equal(carry_coefficients(result, [[0.25]], decimals),
+                                  carry_coefficients(result, [[0.25]], eta))
