@@ -216,3 +216,44 @@ def test_defaults_one_rk4_step_the_plant_name_and_the_observer_name_message():
     np.testing.assert_allclose(np.asarray(s1).ravel(), expected, rtol=1e-13, atol=1e-13)
     with pytest.raises(ObserverError, match="^observer name 'bad-name' must start with a letter"):
         hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], 0.1, name="bad-name")
+
+
+# --- samp1: mutation survivors of uvsym.observers.hybrid ---
+
+
+def test_no_disturbance_columns_give_rank_zero_and_no_decoupling():
+    A, sys3 = plant()
+    dec = decouple(sys3, sys3.linearize(), z1=["x1", "x2"], w1=["y1"], E=np.zeros((3, 0)), F=F)
+    # by hand: no disturbance to remove, so H = 0 (2, 1), Tu = I and rank E = 0; B = (0, 1, 0) has rank 1, C B = 0
+    np.testing.assert_array_equal(dec.H, np.zeros((2, 1)))
+    np.testing.assert_array_equal(dec.Tu, np.eye(2))
+    assert dec.ranks == {"B": 1, "E": 0, "C[B E]": 0, "m + r": 1}
+
+
+def test_an_undetectable_subsystem_1_is_kept_as_evidence_not_raised():
+    # x1' = -x1 + d, x2' = x1 + x2 + u, x3' = -x3; y = (x1, x3); z1 = (x1, x2), w1 = y1, E1 = (1, 0)
+    A = np.array([[-1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, -1.0]])
+    sys3 = system("unstable", "x2 unseen", x=signals(("x1", "m"), ("x2", "m"), ("x3", "m"), group="state"),
+                  u=signals(("u", "m/s"), group="input"), d=signals(("d", "m/s"), group="disturbance"),
+                  y=signals(("y1", "m"), ("y3", "m"), group="output"),
+                  rhs=lambda x, u, d, p: ca.mtimes(ca.DM(A), x) + ca.vertcat(d, u, 0),
+                  output=lambda x, u, p: ca.vertcat(x[0], x[2]))
+    dec = decouple(sys3, sys3.linearize(), z1=["x1", "x2"], w1=["y1"])
+    # by hand: H = (1, 0), Tu = diag(0, 1), Tu A11 = [[0, 0], [1, 1]]; C1 = (1, 0) sees no x2 (C1 Tu A11 = 0),
+    # so the mode +1 of x2 is unobservable and unstable
+    np.testing.assert_allclose(dec.omega["Omega1"], [[0.0, 0.0], [1.0, 1.0]])
+    assert len(dec.undetectable) == 1 and dec.undetectable[0] == pytest.approx(1.0)
+
+
+def test_estimator_gain_errors_name_gamma_and_the_description_names_the_kind():
+    A, sys3 = plant()
+    dec = split(sys3)
+    with pytest.raises(ObserverError, match=r"^est: Gamma must be a finite \(1, 1\) matrix, got shape \(2, 2\)$"):
+        hybrid_observer(sys3, dec, [[1.0], [0.0]], [[1.0]], DT, name="est",
+                        estimator=FaultEstimator(Gamma=np.eye(2), M1=[[1.0]], M2=[[0.0]]))
+    est = hybrid_observer(sys3, dec, [[1.0], [0.0]], [[1.0]], 0.5,
+                          estimator=FaultEstimator(Gamma=[[1.0]], M1=[[1.0]], M2=[[0.0]]))
+    assert est.description == ("hybrid unknown-input observer of three, fault estimator (eq. 18), sampled every "
+                               "0.5 s (1 RK4 step(s))")
+    detect = hybrid_observer(sys3, dec, [[1.0], [0.0]], [[1.0]], 0.5)
+    assert ", detection observer (eq. 6), " in detect.description
