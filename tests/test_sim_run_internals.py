@@ -203,3 +203,21 @@ def test_a_failed_compilation_warns_at_the_runs_caller_and_runs_interpreted(monk
 ])
 def test_sizes_print_in_the_largest_binary_unit_below_1024(count, text):
     assert run._bytes(count) == text
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_available_memory_falls_back_to_the_physical_memory(monkeypatch):
+    """Without /proc/meminfo, the physical memory: MemTotal (kB) is the same page count on Linux."""
+    try:
+        with open("/proc/meminfo") as handle:
+            total = next(int(line.split()[1]) * 1024 for line in handle if line.startswith("MemTotal:"))
+    except (OSError, StopIteration):
+        pytest.skip("no /proc/meminfo to compare with")
+
+    def unreadable(*args, **kwargs):
+        raise OSError("no /proc")
+
+    monkeypatch.setattr(run, "open", unreadable, raising=False)
+    assert run.available_memory() == total
