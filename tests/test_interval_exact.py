@@ -9,6 +9,7 @@ squaring the bounds: ``lo <= x^(k/2)`` exactly when ``lo^2 <= x^k`` for ``lo >= 
 from __future__ import annotations
 
 import math
+import warnings
 from fractions import Fraction
 
 import casadi as ca
@@ -256,3 +257,29 @@ def test_indicators_of_decided_and_undecided_boxes():
     (lo, hi), undecided = ia.indicator(np.array([True, False, False]), np.array([False, True, False]))
     assert lo.tolist() == [1.0, 0.0, 0.0] and hi.tolist() == [1.0, 0.0, 1.0]
     assert undecided.tolist() == [False, False, True]
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_quotients_of_several_boxes_are_bounded_box_by_box():
+    """[1, 2] / [1, 2] = [0.5, 2] and [1, 2] / [4, 8] = [0.125, 0.5] (exact in doubles, rounded out by one ulp)."""
+    lo, hi = ia.div((np.array([1.0, 1.0]), np.array([2.0, 2.0])), (np.array([1.0, 4.0]), np.array([2.0, 8.0])))
+    assert lo.tolist() == [0.5 - math.ulp(0.5) / 2, 0.125 - math.ulp(0.125) / 2]
+    assert hi.tolist() == [2.0 + math.ulp(2.0), 0.5 + math.ulp(0.5)]
+
+
+def test_a_fractional_power_rounds_both_ends_out_by_the_library_ulps():
+    """9^0.5 = 3 and 4^-0.5 = 0.5 exactly (pow is exact there); each bound moves LIBM_ULPS doubles outward."""
+    n = ia.LIBM_ULPS
+    lo, hi = ia.power((np.array([9.0]), np.array([9.0])), 0.5)
+    assert (lo[0], hi[0]) == (3.0 - n * math.ulp(3.0), 3.0 + n * math.ulp(3.0))
+    lo, hi = ia.power((np.array([4.0]), np.array([4.0])), -0.5)
+    assert hi[0] == 0.5 + n * math.ulp(0.5)
+
+
+def test_a_negative_fractional_power_of_a_box_reaching_zero_is_unbounded_without_a_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lo, hi = ia.power((np.array([0.0]), np.array([4.0])), -0.5)
+    assert lo[0] == 0.5 - ia.LIBM_ULPS * math.ulp(0.5) / 2 and hi[0] == np.inf
