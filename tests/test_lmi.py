@@ -143,3 +143,29 @@ def test_a_mode_at_the_tolerance_edge_of_the_decay_is_still_tried():
     evidence = dual_certificate(block_lmi([[0.0, 1.0], [0.0, -1e-9]], [("e", [[0.0, 0.0]])]))
     assert evidence["Z"] == [["1", "0"], ["0", "0"]]
     assert sorted(m["eigenvalue"][0] for m in evidence["modes"]) == [-1e-9, 0.0]
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_a_dual_candidate_must_be_non_zero_and_semidefinite():
+    """Omega = 1, nothing measured, decay 0: Z = 1 gives S = 2 Z = 2 >= 0 (a certificate); Z = 0 is the trivial
+    point of every cone and Z = -1 is not semidefinite."""
+    from uvsym.verify.lmi import _dual_holds
+    problem = block_lmi([[1.0]], [("e", [[0.0]])], 0.0)
+    assert _dual_holds(problem, [[Fraction(1)]])
+    assert not _dual_holds(problem, [[Fraction(0)]]) and not _dual_holds(problem, [[Fraction(-1)]])
+
+
+def test_a_mode_faster_than_the_decay_is_no_dual_candidate():
+    """Omega = diag(0, -0.5), nothing measured, decay 0: only the mode 0 has Re lambda >= -alpha."""
+    from uvsym.verify.lmi import _mode_candidates
+    candidates = _mode_candidates(block_lmi(np.diag([0.0, -0.5]), [("e", [[0.0, 0.0]])], 0.0))
+    assert [info["eigenvalue"] for _, info in candidates] == [[0.0, 0.0]]
+
+
+def test_at_zero_decay_the_design_still_asks_for_a_strictly_positive_rate():
+    """x' = -k x + ..., y = x, decay 0: the design at rate r needs 2 p (r - k) <= -1e-6 with p >= 1, so at the
+    design rate 1e-6 the gain is k >= 1.5e-6 (at rate 0 alone, 5e-7 would do)."""
+    gains, certificate = solve_block_lmi(block_lmi([[0.0]], [("e", [[1.0]])], 0.0))
+    assert certificate.status == "proved" and gains.K[0][0, 0] > 1.4e-6
