@@ -435,3 +435,15 @@ def test_convergence_claims_take_the_corners_of_the_desired_actions():
     P, A = np.array(bias.details["P"]), -np.diag([3.0, 1.0 / 3.0])
     assert np.linalg.eigvalsh(P).min() > 0 and np.linalg.eigvalsh(A.T @ P + P @ A + 0.5 * P).max() < 0
     assert_refuted(convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.5, expected="refuted"))
+
+
+# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_convergence_claims_take_integer_and_rational_gains_as_reals():
+    """K = (3, 1/3) given as an int and a Fraction: the same claim and set as for the doubles (3.0, 0.333333)."""
+    from uvsym.verify.observers import convergence_claim
+
+    bias = convergence_claim("Toy", _toy_observer("bias"), [3, Fraction(1, 3)], 5.0, 9.0, 0.25)
+    assert_proved(bias)
+    assert bias.set == "K = [3.0, 0.333333]"
