@@ -21,11 +21,11 @@ def three():
                   output=lambda x, u, p: ca.vertcat(x[0], x[2]))
 
 
-def lag(y_group: str = "output"):
-    """x1' = -x1 + d, x2' = x1 - a x2 + u (a = 2.5 1/s by default); y = (x1, x2)."""
+def lag(y_group: str = "output", u_group: str = "input", p_group: str = "parameter"):
+    """x1' = -x1 + d, x2' = x1 - a x2 + u (a = 2.5 1/s by default); y = (x1, x2); groups as labelled."""
     return system("lag", "two first-order lags", x=signals(("x1", "m"), ("x2", "m"), group="state"),
-                  u=signals(("u", "m/s"), group="input"), d=signals(("d", "m/s"), group="disturbance"),
-                  p=signals(("a", "1/s"), group="parameter"), y=signals(("y1", "m"), ("y2", "m"), group=y_group),
+                  u=signals(("u", "m/s"), group=u_group), d=signals(("d", "m/s"), group="disturbance"),
+                  p=signals(("a", "1/s"), group=p_group), y=signals(("y1", "m"), ("y2", "m"), group=y_group),
                   rhs=lambda x, u, d, p: ca.vertcat(-x[0] + d, x[0] - p[0] * x[1] + u), output=lambda x, u, p: x,
                   p0=[2.5])
 
@@ -69,14 +69,15 @@ def test_published_signals_read_signals_and_their_groups():
     assert obs.reads_y.names == ("y1", "y3") and obs.reads_u.names == ("u",)
 
 
-def test_a_mix_of_estimates_and_residuals_is_a_plain_signal_group():
-    # the plant labels its outputs "estimate" (e.g. they come from an upstream filter): the residuals the
-    # observer publishes are still not estimates, so the published group is the generic "signal"
-    plant = lag("estimate")
+def test_the_observer_relabels_the_plant_groups_and_publishes_a_plain_signal_group():
+    # the plant labels its outputs "estimate" (e.g. they come from an upstream filter), its inputs "command" and
+    # its parameters "constant": the observer reads them as measurements, inputs and parameters, and the
+    # residuals it publishes are still not estimates, so the published group is the generic "signal"
+    plant = lag("estimate", "command", "constant")
     obs = hybrid_observer(plant, decouple(plant, plant.linearize(), z1=["x1"], w1=["y1"]), [[2.0]], [[4.0]], 0.1)
     assert obs.publishes.names == ("x1_hat", "x2_hat", "r_y1", "r_y2")
     assert obs.publishes.group == "signal"
-    assert obs.reads_y.group == "measurement"
+    assert (obs.reads_y.group, obs.reads_u.group, obs.params.group) == ("measurement", "input", "parameter")
 
 
 def test_the_plant_parameters_and_their_defaults_are_the_observer_parameters():
