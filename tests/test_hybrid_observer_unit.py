@@ -5,7 +5,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from uvsym.errors import ObserverError
+from uvsym.errors import ModelError, ObserverError
 from uvsym.observers.hybrid import FaultEstimator, decouple, hybrid_observer
 from uvsym.systems import signals, system
 
@@ -134,3 +134,16 @@ def test_the_initial_state_puts_the_estimate_at_the_operating_point():
     obs = hybrid_observer(sys3, split3(sys3), [[1.0], [0.0]], [[1.0]], 0.1)
     # by hand: x_op = 0, H = (1, 1): zhat1 = v + H y1 = 0 needs v = -H y1; zhat2 starts at x_op3 = 0
     np.testing.assert_array_equal(obs.initial_state([2.0, 5.0], [0.0]), [-2.0, -2.0, 0.0])
+
+
+def test_published_names_that_collide_are_a_typed_error_naming_them():
+    # state r_y1 publishes r_y1_hat and output y1_hat publishes the residual r_y1_hat; the plant labels its
+    # states "residual", yet the published estimates and residuals together are the generic "signal" group
+    plant = system("clash", "x1' = -x1 + d, x2' = x1 - x2 + u, y = x",
+                   x=signals(("r_y1", "m"), ("x2", "m"), group="residual"), u=signals(("u", "m/s"), group="input"),
+                   d=signals(("d", "m/s"), group="disturbance"),
+                   y=signals(("y1_hat", "m"), ("y2", "m"), group="output"),
+                   rhs=lambda x, u, d, p: ca.vertcat(-x[0] + d, x[0] - x[1] + u), output=lambda x, u, p: x)
+    dec = decouple(plant, plant.linearize(), z1=["r_y1"], w1=["y1_hat"])
+    with pytest.raises(ModelError, match=r"^signal names must be unique; repeated: \['r_y1_hat'\]$"):
+        hybrid_observer(plant, dec, [[2.0]], [[4.0]], 0.1)
