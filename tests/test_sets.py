@@ -419,3 +419,75 @@ def test_carried_noise_coefficients_accept_any_real_numbers():
     decimals = [[[Decimal("0.5")]]] * 3
     np.testing.assert_array_equal(carry_coefficients(result, [[0.25]], decimals),
                                   carry_coefficients(result, [[0.25]], eta))
+
+
+# --- prop1: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_a_non_square_a_is_named_with_its_shape():
+    Z = box([-1.0, -1.0], [1.0, 1.0])
+    with pytest.raises(SetError, match=r"^A must be square, got shape \(2, 3\)$"):
+        propagate(np.full((2, 3), 0.1), np.eye(2), Z, Z, 5, 4)
+
+
+@pytest.mark.parametrize("steps", [True, 2.0, "3"])
+def test_steps_that_are_not_integers_are_refused(steps):
+    """A bool, a float or a string is no step count, even when it compares as >= 1."""
+    Z = box([-1.0], [1.0])
+    with pytest.raises(SetError, match=rf"^steps must be a positive integer, got {steps!r}$"):
+        propagate([[0.5]], [[1.0]], Z, Z, steps, 2)
+
+
+def test_propagation_reduces_with_the_method_asked_for():
+    """x+ = x / 2 + w, generators (2, 0), (0.3, 0.3) and two zero noise generators, at most 3 kept: step 1 has
+    (1, 0), (0.15, 0.15), 0, 0 and boxes 3 of them. Girard keeps the largest ||g||_1 - ||g||_inf, (0.15, 0.15),
+    and boxes (1, 0): x1 - x2 has radius |0.15 - 0.15| + 1 = 1, the exact one. Combastel keeps the longest,
+    (1, 0), and boxes (0.15, 0.15) into (0.15, 0), (0, 0.15): radius 1 + 0.15 + 0.15 = 1.3."""
+    initial = Zonotope([0.0, 0.0], [[2.0, 0.3], [0.0, 0.3]])
+    noise = Zonotope([0.0, 0.0], np.zeros((2, 2)))
+    for method, radius in (("girard", 1.0), ("combastel", 1.3)):
+        result = propagate(0.5 * np.eye(2), [[1.0, -1.0]], initial, noise, 2, 3, method=method)
+        assert result.exact_radius[1, 0] == pytest.approx(1.0, rel=1e-12)
+        assert result.upper[1, 0] == pytest.approx(radius, rel=1e-12)
+        assert result.lower[1, 0] == pytest.approx(-radius, rel=1e-12)
+
+
+def test_untracked_propagation_forms_no_coefficient_maps(monkeypatch):
+    """track=False: every reduction is asked for no map R (it would only cost time), boxing 3 generators in R^1."""
+    from uvsym.sets import propagation
+
+    maps = []
+
+    def spy(*args, **kwargs):
+        result = reduce(*args, **kwargs)
+        maps.append(result.coefficients)
+        return result
+
+    monkeypatch.setattr(propagation, "reduce", spy)
+    propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), box([-1.0], [1.0]), 3, 1, track=False)
+    assert maps == [None, None]
+
+
+def test_propagation_reports_the_noise_generator_count():
+    W = Zonotope([0.0], [[0.1, 0.2, 0.3]])
+    assert propagate([[0.5]], [[1.0]], box([-1.0], [1.0]), W, 2, 4).noise_generators == 3
+
+
+def test_growth_tolerance_is_relative_to_a_small_exact_radius():
+    """|x0| <= 1e-9 at step 0: hull radius = exact radius = 1e-9. With growth_limit 1 - 1e-6 the excess is
+    1e-15, far above the tolerance 1e-12 * 1e-9 = 1e-21 (an absolute 1e-12 would hide it)."""
+    tiny = box([-1e-9], [1e-9])
+    with pytest.raises(SetDivergenceError, match=r"^the enclosure grows: at step 0, output 0's"):
+        propagate([[0.5]], [[1.0]], tiny, tiny, 2, 2, growth_limit=1.0 - 1e-6)
+
+
+def test_growth_error_names_the_output_with_the_largest_ratio_whatever_its_scale_and_centre():
+    """x+ = x / 2, generators 0.01 (1, 1), 0.01 (1, -1), centre (0.02, -0.03), and a zero noise generator; 2 kept,
+    so step 1 boxes all three: radii (0.01, 0.01). Output 0 = 100 x1: centre 1, hull radius 1 = exact 1 (ratio 1);
+    output 1 = x1 + x2: centre -0.005, hull radius 0.02, exact |0.005 + 0.005| + |0.005 - 0.005| = 0.01
+    (ratio 2 > 1.5). Output 1 is named, though output 0's radius, exact radius and upper bound are larger."""
+    initial = Zonotope([0.02, -0.03], [[0.01, 0.01], [0.01, -0.01]])
+    noise = Zonotope([0.0, 0.0], np.zeros((2, 1)))
+    with pytest.raises(SetDivergenceError, match=r"^the enclosure grows: at step 1, output 1's hull radius 0\.02 "
+                       r"exceeds 1\.5 times the exact set's 0\.01 \(reduction wraps; raise generators\)$"):
+        propagate(0.5 * np.eye(2), [[100.0, 0.0], [1.0, 1.0]], initial, noise, 2, 2, growth_limit=1.5)
