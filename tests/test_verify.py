@@ -450,3 +450,17 @@ def test_convergence_claims_take_integer_and_rational_gains_as_reals():
     bias = convergence_claim("Toy", _toy_observer("bias"), [3, Fraction(1, 3)], 5.0, 9.0, 0.25)
     assert_proved(bias)
     assert bias.set == "K = [3.0, 0.333333]"
+
+
+# --- prop1: mutation survivors -----------------------------------------------------------------------------------
+
+
+def test_convergence_claims_keep_the_expected_status_they_are_given():
+    """A negative control (gamma 1 > the slowest rate 3 * 0.5^2 = 0.75) comes out refuted AS EXPECTED; the same
+    claim expected proved is an unexpected refutation."""
+    from uvsym.verify.observers import convergence_claim
+
+    control = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0, expected="refuted")
+    assert (control.status, control.expected, control.as_expected) == ("refuted", "refuted", True)
+    claim = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0)
+    assert (claim.status, claim.expected, claim.as_expected) == ("refuted", "proved", False)
