@@ -421,7 +421,7 @@ def test_carried_noise_coefficients_accept_any_real_numbers():
                                   carry_coefficients(result, [[0.25]], eta))
 
 
-# --- prop1: mutation survivors -----------------------------------------------------------------------------------
+# --- propagation: edge cases (mutation survivors) --------------------------------------
 
 
 def test_a_non_square_a_is_named_with_its_shape():

@@ -452,7 +452,7 @@ def test_convergence_claims_take_integer_and_rational_gains_as_reals():
     assert bias.set == "K = [3.0, 0.333333]"
 
 
-# --- prop1: mutation survivors -----------------------------------------------------------------------------------
+# --- convergence claims: the expected status (mutation survivors) ----------------------------------------------
 
 
 def test_convergence_claims_keep_the_expected_status_they_are_given():
