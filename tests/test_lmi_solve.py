@@ -37,8 +37,8 @@ def _decays(problem, P, K, rate):
     # e2 drives e1 with gain 3: P = diag(p1, p2) needs p2 > 9 p1 at rate 0.5 (det of [[-p1, 3 p1], [3 p1, -p2]])
     ([[-1.0, 3.0], [0.0, -1.0]], ([[0.0]], [[0.0]]), [1.0, 4.0]),
     ([[-1.0, 3.0], [0.0, -1.0]], ([[0.0]], [[0.0]]), [4.0, 1.0]),
-    # the same with e2 unstable and measured: only a gain K2 > 1.5 on e2 decays at rate 0.5
-    ([[-1.0, 3.0], [0.0, 1.0]], ([[0.0]], [[1.0]]), [1.0, 4.0]),
+    # the same with e2 unstable and measured (a gain K2 > 1.5 is needed), e2 scaled down: C_2 D_2 = 1/4
+    ([[-1.0, 3.0], [0.0, 1.0]], ([[0.0]], [[1.0]]), [1.0, 0.25]),
 ])
 def test_a_solution_in_scaled_coordinates_decays_in_the_original_ones(omega, outputs, D):
     """Solved for D^-1 e (D diagonal, powers of two), the P, K mapped back satisfy the LMI for e itself."""
@@ -100,7 +100,8 @@ def test_only_the_inaccuracy_warning_of_the_solver_is_silenced(monkeypatch):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         assert _solve(block_lmi([[-1.0]], [("e", [[1.0]])]), 0.5, np.ones(1)) is not None
-    assert [str(w.message) for w in caught] == ["something else happened"]
+    messages = [str(w.message) for w in caught]
+    assert "something else happened" in messages and not any(m.startswith("Solution may") for m in messages)
 
 
 # --- _exact_check: hand-computed pivots -----------------------------------------------------------------------
