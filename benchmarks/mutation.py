@@ -20,10 +20,11 @@ script copies the working tree (tracked and new files, not ignored ones) to a sc
 
 ``--sample N`` tests N mutants of each module drawn at random (seeded by the module's path; ``--seed TEXT`` draws
 another sample), an estimate (``sample`` in each module's record; the others count as not checked).
-``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests there and tests again only the
-mutants that were not killed (the tests kept there only add kills, so the result is that of a full run with the
-current tests on the source copied then). ``--before --tests-at COMMIT`` records a baseline with an earlier
-commit's tests under the key ``before``.
+``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests and [tool.mutmut] (its
+``only_mutate`` kept) there and tests again only the mutants that were not killed. The tests kept there only add
+kills, so the result is that of a full run with the current tests on the source copied then: a kill that mutmut
+drops unchecked because the test selection changed is put back. ``--before --tests-at COMMIT`` records a
+baseline with an earlier commit's tests under the key ``before``.
 """
 
 from __future__ import annotations
@@ -97,13 +98,19 @@ def _copy_listed(destination: Path, folders: list[str], without: list[str]) -> N
 
 def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[str], tests_at: str | None) -> None:
     """The working tree's uvsym/, derivations/ and pyproject.toml in ``scratch``, its tests (or those of
-    ``tests_at``), ``only_mutate`` narrowed to ``modules``. A selected test file that is missing becomes an empty
-    one, so that the selection (which mutmut's cache is keyed on) stays the same when ``--again`` brings it."""
+    ``tests_at``), ``only_mutate`` narrowed to ``modules``."""
     _copy_listed(scratch, ["uvsym", "derivations", "pyproject.toml"], [])
     _copy_tests(scratch, without, tests_at)
-    for name in config["pytest_add_cli_args_test_selection"]:
-        if not (scratch / name).exists():
-            (scratch / name).write_text('"""Not in the tests measured (benchmarks/mutation.py)."""\n')
+    _write_config(scratch, config, modules)
+
+
+def _write_config(scratch: Path, config: dict, modules: list[str]) -> None:
+    """``scratch``'s [tool.mutmut] set to ``config`` with ``only_mutate`` = ``modules``; a selected test file that
+    is missing there becomes an empty one (mutmut's pytest would stop on a missing path)."""
+    for folder in (scratch, scratch / "mutants"):
+        for name in config["pytest_add_cli_args_test_selection"]:
+            if folder.is_dir() and not (folder / name).exists():
+                (folder / name).write_text('"""Not in the tests measured (benchmarks/mutation.py)."""\n')
     section = "[tool.mutmut]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in {**config,
                                                                                      "only_mutate": modules}.items())
     text = (scratch / "pyproject.toml").read_text()
@@ -111,15 +118,28 @@ def _copy_tree(scratch: Path, config: dict, modules: list[str], without: list[st
     (scratch / "pyproject.toml").write_text(text)
 
 
-def _current_timeouts(scratch: Path, config: dict) -> None:
-    """The kept run's [tool.mutmut] with the current timeouts (its test selection and options stay: mutmut drops
-    every cached verdict when those change)."""
-    text = (scratch / "pyproject.toml").read_text()
-    for key in ("timeout_multiplier", "timeout_constant"):
-        text = re.sub(rf"(?m)^{key} = .*\n", "", text)
-        if key in config:
-            text = text.replace("[tool.mutmut]\n", f"[tool.mutmut]\n{key} = {_toml_value(config[key])}\n", 1)
-    (scratch / "pyproject.toml").write_text(text)
+def _exit_codes(scratch: Path, modules: list[str]) -> dict[str, dict[str, int | None]]:
+    """module -> mutant name -> mutmut's exit code (None: not checked), from the .meta files in ``scratch``."""
+    out = {}
+    for module in modules:
+        meta = scratch / "mutants" / f"{module}.meta"
+        out[module] = json.loads(meta.read_text())["exit_code_by_key"] if meta.exists() else {}
+    return out
+
+
+def _keep_kills(scratch: Path, kept: dict[str, dict[str, int | None]]) -> None:
+    """Put back the kills of the kept run that mutmut dropped, unchecked, when the test selection changed: the
+    tests kept there are still selected, so they still kill those mutants (the source has not changed)."""
+    from mutmut.stats import status_by_exit_code
+
+    for module, codes in kept.items():
+        meta = scratch / "mutants" / f"{module}.meta"
+        data = json.loads(meta.read_text())
+        now = data["exit_code_by_key"]
+        for name, code in codes.items():
+            if now.get(name) is None and status_by_exit_code[code] in KILLED:
+                now[name] = code
+        meta.write_text(json.dumps(data, indent=4))
 
 
 def _equivalents() -> list[dict]:
@@ -132,12 +152,8 @@ def _outcomes(scratch: Path, modules: list[str]) -> dict[str, dict[str, str]]:
     """module -> mutant name -> status, from the .meta files mutmut wrote in ``scratch/mutants``."""
     from mutmut.stats import status_by_exit_code
 
-    out = {}
-    for module in modules:
-        meta = scratch / "mutants" / f"{module}.meta"
-        codes = json.loads(meta.read_text())["exit_code_by_key"] if meta.exists() else {}
-        out[module] = {name: status_by_exit_code[code] for name, code in codes.items()}
-    return out
+    return {module: {name: status_by_exit_code[code] for name, code in codes.items()}
+            for module, codes in _exit_codes(scratch, modules).items()}
 
 
 _DIFFS = """
@@ -243,7 +259,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.again:
             for destination in (scratch, scratch / "mutants"):
                 _copy_tests(destination, args.without, args.tests_at)
-            _current_timeouts(scratch, config)
+            kept_codes = _exit_codes(scratch, modules)
+            _write_config(scratch, config, kept)
             again = {"survived", "no tests", "suspicious", "timeout"} | (set() if args.sample else {"not checked"})
             names = sorted(n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
                            if s in again)
@@ -262,6 +279,8 @@ def main(argv: list[str] | None = None) -> int:
         run = subprocess.run(["nice", "-n", "15", mutmut, "run", "--max-children", str(args.max_children), *names],
                              cwd=scratch, env=env, capture_output=True, text=True)
         (scratch / "mutmut-run.log").write_text(run.stdout + run.stderr)
+        if args.again:
+            _keep_kills(scratch, kept_codes)
         seconds = time.perf_counter() - clock
         equivalents = {e["mutant"]: e for e in _equivalents()}
         per_module, survivors, justified = {}, [], {}

@@ -2,6 +2,7 @@
 only its own mutant, or the same change renumbered within the same function; every entry says why."""
 
 import importlib.util
+import json
 import tomllib
 from pathlib import Path
 
@@ -39,3 +40,34 @@ def test_every_equivalent_names_one_mutant_of_a_mutated_module_with_its_change_a
         assert entry["change"].strip() and len(entry["reason"]) > 15, entry["mutant"]
         module = mutation._function_of(entry["mutant"]).rsplit(".", 1)[0]
         assert (ROOT / (module.replace(".", "/") + ".py")).is_file(), f"{entry['mutant']}: no module {module}"
+
+
+def test_again_puts_back_only_the_kills_mutmut_dropped_unchecked(tmp_path):
+    # exit codes: 1 killed, 36 timeout (a kill), 0 survived, None not checked (mutmut's convention)
+    meta = tmp_path / "mutants" / "uvsym" / "m.py.meta"
+    meta.parent.mkdir(parents=True)
+    kept = {"uvsym/m.py": {"k": 1, "t": 36, "s": 0, "n": None, "again": 0}}
+    # after a run under a new test selection: the old verdicts dropped, the survivor tested again and now killed
+    meta.write_text('{"exit_code_by_key": {"k": null, "t": null, "s": null, "n": null, "again": 1}, "other": 7}')
+    mutation._keep_kills(tmp_path, kept)
+    data = json.loads(meta.read_text())
+    assert data["exit_code_by_key"] == {"k": 1, "t": 36, "s": None, "n": None, "again": 1}
+    assert data["other"] == 7
+
+
+def test_the_written_config_keeps_the_modules_and_stands_in_for_missing_selected_tests(tmp_path):
+    (tmp_path / "mutants" / "tests").mkdir(parents=True)
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "test_a.py").write_text("def test_a():\n    assert True\n")
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n\n[tool.mutmut]\nonly_mutate = ["old"]\n\n'
+                                             '[tool.ruff]\nline-length = 120\n')
+    config = {"only_mutate": ["uvsym/*.py"], "pytest_add_cli_args_test_selection": ["tests/test_a.py",
+                                                                                      "tests/test_new.py"]}
+    mutation._write_config(tmp_path, config, ["uvsym/m.py"])
+    written = tomllib.loads((tmp_path / "pyproject.toml").read_text())
+    assert written["tool"]["mutmut"]["only_mutate"] == ["uvsym/m.py"]
+    assert written["tool"]["mutmut"]["pytest_add_cli_args_test_selection"] == ["tests/test_a.py", "tests/test_new.py"]
+    assert written["tool"]["ruff"] == {"line-length": 120} and written["project"] == {"name": "x"}
+    assert (tmp_path / "tests" / "test_a.py").read_text().startswith("def test_a")  # an existing file is left alone
+    for folder in (tmp_path, tmp_path / "mutants"):
+        assert "Not in the tests measured" in (folder / "tests" / "test_new.py").read_text()
