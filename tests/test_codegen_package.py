@@ -332,7 +332,7 @@ def test_build_files_manifest_names_and_layout_follow_the_package_name(tmp_path)
     assert text.startswith('{\n  "casadi": "') and '\n    "PKG_OK": {\n      "meaning": ' in text
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- C package: SX graphs and header comments (mutation survivors) -----------------------------------------------
 
 
 def test_a_renamed_sx_function_stays_an_sx_graph():

@@ -218,7 +218,7 @@ def test_defaults_one_rk4_step_the_plant_name_and_the_observer_name_message():
         hybrid_observer(sys3, dec, [[20.0], [0.0]], [[5.0]], 0.1, name="bad-name")
 
 
-# --- samp1: mutation survivors of uvsym.observers.hybrid ---
+# --- decoupling: edge cases (mutation survivors) ---------------------------------------------------------------------
 
 
 def test_no_disturbance_columns_give_rank_zero_and_no_decoupling():

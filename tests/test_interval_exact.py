@@ -259,7 +259,7 @@ def test_indicators_of_decided_and_undecided_boxes():
     assert undecided.tolist() == [False, False, True]
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- quotients and powers: outward rounding (mutation survivors) -----------------------------------------------------
 
 
 def test_quotients_of_several_boxes_are_bounded_box_by_box():

@@ -145,7 +145,7 @@ def test_a_mode_at_the_tolerance_edge_of_the_decay_is_still_tried():
     assert sorted(m["eigenvalue"][0] for m in evidence["modes"]) == [-1e-9, 0.0]
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- dual candidates: edge cases (mutation survivors) ----------------------------------------------------------------
 
 
 def test_a_dual_candidate_must_be_non_zero_and_semidefinite():

@@ -516,7 +516,7 @@ def test_step_claim_takes_a_column_of_samples_and_states_its_set_bound_and_expec
     assert 0.0 < certificate.seconds <= elapsed  # its own duration, measured around the call
 
 
-# --- samp1: mutation survivors of uvsym.observers.lms_supervisor ---
+# --- double criterion and supervisor: edge cases (mutation survivors) ------------------------------------------------
 
 
 def test_double_criterion_names_its_inputs_outputs_and_state_symbols():

@@ -397,7 +397,7 @@ def test_box_reductions_use_the_compiled_kernel_when_one_is_built(monkeypatch):
     assert calls == [(False, True), (True, True), (False, False)]
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- growth limit and reduction: edge cases (mutation survivors) -----------------------------------------------------
 
 
 def test_a_hull_radius_exactly_at_the_growth_limit_is_accepted():

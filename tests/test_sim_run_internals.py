@@ -205,7 +205,7 @@ def test_sizes_print_in_the_largest_binary_unit_below_1024(count, text):
     assert run._bytes(count) == text
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- available memory: the fallback (mutation survivors) -----------------------------------------------------------
 
 
 def test_available_memory_falls_back_to_the_physical_memory(monkeypatch):

@@ -286,7 +286,7 @@ def test_the_description_gives_the_defaults_and_the_sample_period():
         "UKF of linear (alpha 0.5, beta 2, kappa 1.5), sampled every 0.1 s")
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- square-root factors and covariance units: edge cases (mutation survivors) ---------------------------------------
 
 
 def test_the_factor_of_an_indefinite_matrix_is_the_documented_diagonal_fallback():

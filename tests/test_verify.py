@@ -440,7 +440,7 @@ def test_convergence_claims_take_the_corners_of_the_desired_actions():
     assert_refuted(convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.5, expected="refuted"))
 
 
-# --- samp2: mutation survivors -----------------------------------------------------------------------------------
+# --- convergence claims: integer and rational gains (mutation survivors) ---------------------------------------------
 
 
 def test_convergence_claims_take_integer_and_rational_gains_as_reals():
