@@ -70,6 +70,7 @@ def test_a_marked_function_compiles_with_unused_parameter_warnings_as_errors(tmp
         (tmp_path / "f.c").write_text(text)
         done = subprocess.run([*flags, str(tmp_path / "f.c")], capture_output=True, text=True)
         assert (done.returncode == 0) == compiles, done.stderr
+        assert compiles or "unused parameter" in done.stderr
 
 
 # --- header -----------------------------------------------------------------------------------------------------

@@ -44,12 +44,11 @@ def split(sys3, **kw):
 
 
 def test_a_singular_value_at_the_tolerance_does_not_count():
-    # B = [[0, 0], [1, 0], [0, 1e-9]]: singular values exactly 1 and 1e-9 = 1e-9 x the largest, which is not above
-    # the tolerance (numpy's matrix_rank draws the same strict line)
+    # B = [[0, 0], [1, 0], [0, 1e-9]] and C [B E] = [[0, 0, 1], [0, 1e-9, 0]]: singular values exactly 1 and
+    # 1e-9 = 1e-9 x the largest, which is not above the tolerance
     dec = split(plant(b=(1.0, 1e-9)))
-    B = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1e-9]])
-    assert np.linalg.matrix_rank(B, tol=1e-9) == 1
-    # C [B E] = [[0, 0, 1], [0, 1e-9, 0]]: singular values 1, 1e-9 again
+    for M in (np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1e-9]]), np.array([[0.0, 0.0, 1.0], [0.0, 1e-9, 0.0]])):
+        assert np.linalg.svd(M, compute_uv=False).tolist() == [1.0, 1e-9]  # the premise: exact singular values
     assert dec.ranks == {"B": 1, "E": 1, "C[B E]": 1, "m + r": 2}
 
 

@@ -124,7 +124,8 @@ def test_a_skipped_update_far_from_the_origin_publishes_a_zero_residual_and_log_
     exactly 0 (a residual of order 1e200 would square to inf, and 0 * inf is NaN)."""
     obs = ekf(held(0.1), dt=0.1, Q=1.0, R=1.0, P0=1.0, x0=[1e200])
     S, OUT = run_filter(obs, [[np.nan]], [[0.0]])
-    assert OUT[0].tolist() == [1e200, 0.0, 0.0, OUT[0, 3], 1.0]
+    assert OUT[0, [0, 1, 2, 4]].tolist() == [1e200, 0.0, 0.0, 1.0]
+    assert OUT[0, 3] == pytest.approx(1.0 + 1e-12, abs=1e-15)  # pd_margin: a (1 + jitter) / a for the 1x1 pivot
     assert S[1].tolist() == [1e200, 2.0]  # prior kept, then P = 1 + Q
 
 

@@ -150,6 +150,10 @@ def test_a_dual_sdp_certificate_lists_no_modes():
     evidence = dual_certificate(block_lmi(np.array([[-1.0, 3.0], [3.0, -1.0]]), [("a", [[0.0]]), ("b", [[0.0]])]))
     assert evidence["modes"] == [] and evidence["source"] == "dual SDP (cvxpy, Clarabel), rounded"
     assert evidence["check"] == CHECK
+    # Z itself, in rationals: symmetric, >= 0, nonzero, and the 1x1 diagonal blocks of Omega Z + Z Omega^T >= 0
+    (z11, z12), (z21, z22) = [[Fraction(v) for v in row] for row in evidence["Z"]]
+    assert z12 == z21 and z11 >= 0 and z22 >= 0 and z11 * z22 >= z12**2 and (z11, z22) != (0, 0)
+    assert -z11 + 3 * z12 >= 0 and 3 * z12 - z22 >= 0
 
 
 def test_a_stable_unmeasured_state_has_no_certificate_and_no_sdp_candidate():

@@ -1,15 +1,16 @@
 """Block LMI solving (uvsym.verify.lmi: _solve, _exact_check, solve_block_lmi, block_lmi_claim): the solver's
 answer in scaled coordinates mapped back, its optimum against closed forms, the exact re-check against hand
-computations, and what the certificates say (claim, set, method, status, timing)."""
+computations, and what the certificates say (claim, set, method, status, seconds)."""
 
-import time
 import warnings
 from fractions import Fraction
+from types import SimpleNamespace
 
 import cvxpy as cp
 import numpy as np
 import pytest
 
+import uvsym.verify.lmi as lmi
 from uvsym.errors import VerificationError
 from uvsym.verify.lmi import BlockLMI, _exact_check, _solve, block_lmi, block_lmi_claim, solve_block_lmi
 
@@ -83,6 +84,7 @@ def test_a_block_without_measurement_rows_gets_an_empty_gain():
     problem = BlockLMI(("e",), ((Fraction(-1),),), ((),), (1,), Fraction(1, 2))
     gains, certificate = solve_block_lmi(problem)
     assert certificate.status == "proved" and gains.K[0].shape == (1, 0)
+    assert _decays(problem, gains.P, gains.K, 0.5)
     assert certificate.details["K"] == [[[]]]
 
 
@@ -139,54 +141,58 @@ def test_exact_check_names_a_non_finite_gain_or_lyapunov_matrix():
 # --- solve_block_lmi and block_lmi_claim: the certificates -----------------------------------------------------
 
 
-def _timed(call):
-    started = time.perf_counter()
-    result = call()
-    return result, time.perf_counter() - started
+def _clock(monkeypatch):
+    """The module's clock reads 10 s at the start of solve_block_lmi and 12.5 s at its end: 2.5 s taken."""
+    monkeypatch.setattr(lmi, "time", SimpleNamespace(perf_counter=iter([10.0, 12.5]).__next__))
 
 
-def test_a_proved_certificate_says_what_where_how_and_carries_the_gains():
+def test_a_proved_certificate_says_what_where_how_and_carries_the_gains(monkeypatch):
     """diag(1, -1), a measured, b not, decay 0.5: b's mode -1 is fast enough and a gets a gain."""
     problem = block_lmi(np.diag([1.0, -1.0]), [("a", [[1.0]]), ("b", [[0.0]])], 0.5)
-    (gains, certificate), elapsed = _timed(lambda: solve_block_lmi(problem, expected="refuted"))
+    _clock(monkeypatch)
+    gains, certificate = solve_block_lmi(problem, expected="refuted")
     assert (certificate.claim, certificate.set, certificate.method) == ("block LMI", "blocks a, b; decay 0.5 1/s",
                                                                         METHOD)
     assert (certificate.status, certificate.expected) == ("proved", "refuted")
-    assert 0 < certificate.seconds <= elapsed
+    assert certificate.seconds == 2.5
     assert gains.certificate is certificate
     assert [p.tolist() for p in gains.P] == certificate.details["P"]
     assert _decays(problem, gains.P, gains.K, 0.5)
 
 
-def test_a_refuted_certificate_says_what_where_how():
-    """diag(1, -1), nothing measured, decay 0: a's mode 1 is unseen and unstable."""
+def test_a_refuted_certificate_says_what_where_how(monkeypatch):
+    """diag(1, -1), nothing measured, decay 0: a's mode 1 is unseen and unstable; the dual certificate is the mode's
+    direction, Z = e1 e1^T."""
     problem = block_lmi(np.diag([1.0, -1.0]), [("a", [[0.0]]), ("b", [[0.0]])])
-    (gains, certificate), elapsed = _timed(lambda: solve_block_lmi(problem, "unseen mode", "a and b",
-                                                                   expected="refuted"))
+    _clock(monkeypatch)
+    gains, certificate = solve_block_lmi(problem, "unseen mode", "a and b", expected="refuted")
     assert gains is None and certificate.status == "refuted"
+    assert certificate.counterexample["Z"] == [["1", "0"], ["0", "0"]]
     assert (certificate.claim, certificate.set, certificate.method) == ("unseen mode", "a and b", METHOD)
-    assert 0 < certificate.seconds <= elapsed
+    assert certificate.seconds == 2.5
 
 
-def test_an_inconclusive_certificate_says_what_and_where():
+def test_an_inconclusive_certificate_says_what_and_where(monkeypatch):
     """0.5 I, C = (1, 0.1), one block: the unseen direction (-0.1, 1) cannot be rounded to a certificate (test_lmi)."""
     problem = block_lmi(0.5 * np.eye(2), [("e", [[1.0, 0.1]])])
-    (gains, certificate), elapsed = _timed(lambda: solve_block_lmi(problem, "c", expected="refuted"))
+    _clock(monkeypatch)
+    gains, certificate = solve_block_lmi(problem, "c", expected="refuted")
     assert gains is None and certificate.status == "inconclusive"
     assert (certificate.claim, certificate.set) == ("c", "blocks e; decay 0 1/s")
-    assert 0 < certificate.seconds <= elapsed
+    assert certificate.seconds == 2.5
 
 
 def test_a_rate_the_solver_cannot_meet_with_margin_is_tried_at_the_rate_itself():
     """Omega = -1, nothing measured, decay 0.995: 1.01 * 0.995 > 1 is infeasible for the solver, 0.995 is not
     (2 p (-1 + 0.995) < 0), and the exact re-check at 0.995 proves it."""
-    certificate = solve_block_lmi(block_lmi([[-1.0]], [("e", [[0.0]])], 0.995))[1]
-    assert certificate.status == "proved"
+    problem = block_lmi([[-1.0]], [("e", [[0.0]])], 0.995)
+    gains, certificate = solve_block_lmi(problem)
+    assert certificate.status == "proved" and _decays(problem, gains.P, gains.K, 0.995)
 
 
 def test_at_zero_decay_the_design_rate_is_only_a_millionth():
-    """x' = 0 x + K-injection, y = x, decay 0: at the design rate r = 1e-6, with p = 1 the least trace, the least
-    gain has 2 (r - K) = -1e-6: K = 1.5e-6 (a design rate near 1 would give K near 1)."""
+    """x' = -K y with y = x (no own dynamics), decay 0: at the design rate r = 1e-6, with p = 1 the least trace,
+    the least gain has 2 (r - K) = -1e-6: K = 1.5e-6 (a design rate near 1 would give K near 1)."""
     gains = solve_block_lmi(block_lmi([[0.0]], [("e", [[1.0]])], 0.0))[0]
     assert 1.4e-6 < gains.K[0][0, 0] < 1.6e-6
 

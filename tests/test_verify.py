@@ -464,3 +464,4 @@ def test_convergence_claims_keep_the_expected_status_they_are_given():
     assert (control.status, control.expected, control.as_expected) == ("refuted", "refuted", True)
     claim = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0)
     assert (claim.status, claim.expected, claim.as_expected) == ("refuted", "proved", False)
+    assert claim.counterexample["eigenvalue_real"] == pytest.approx(-0.75)  # the slowest rate, 3 * 0.5^2, < gamma
