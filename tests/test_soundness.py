@@ -5,6 +5,8 @@ its regression here; bad inputs get typed errors. (A larger sample: benchmarks/s
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 import time
 from fractions import Fraction
 
@@ -321,6 +323,7 @@ def test_symbolic_step_limits_its_own_cpu_time_and_tells_how_each_entry_vanished
     arithmetic, sin^2 + cos^2 - 1 only by simplification, x - 1 not at all."""
     limits, sent = [], []
     monkeypatch.setattr(identity.resource, "setrlimit", lambda kind, pair: limits.append((kind, pair)))
+    monkeypatch.setattr(identity.resource, "getrlimit", lambda kind: (kind, identity.resource.RLIM_INFINITY))
     monkeypatch.setattr(identity.time, "process_time", lambda: 100.7)
 
     class Channel:
@@ -332,6 +335,37 @@ def test_symbolic_step_limits_its_own_cpu_time_and_tells_how_each_entry_vanished
         identity._symbolic_outcome(entries, Channel, 2.5)
     assert sent == ["exact", "simplify", ""]
     assert limits == [(identity.resource.RLIMIT_CPU, (3 + 100, identity.resource.RLIM_INFINITY))] * 3
+
+
+@pytest.mark.parametrize("hard, soft", [(500, 103), (101, 101)])
+def test_symbolic_step_keeps_a_finite_hard_cpu_limit_it_inherited(monkeypatch, hard, soft):
+    """Under a batch job's ``ulimit -t`` (a finite hard limit, which no process may raise) the child sets its soft
+    limit to ceil(seconds) beyond the CPU time used, capped at the hard limit, and keeps the hard limit."""
+    limits = []
+    monkeypatch.setattr(identity.resource, "setrlimit", lambda kind, pair: limits.append(pair))
+    monkeypatch.setattr(identity.resource, "getrlimit", lambda kind: (hard, hard))
+    monkeypatch.setattr(identity.time, "process_time", lambda: 100.7)
+    identity._symbolic_outcome([sp.Integer(0)], type("Channel", (), {"send": staticmethod(lambda how: None)}), 2.5)
+    assert limits == [(soft, hard)]
+
+
+_UNDER_A_HARD_LIMIT = """
+import resource, sys
+import casadi as ca
+from uvsym.verify.identity import prove_identity
+resource.setrlimit(resource.RLIMIT_CPU, (10_000, 10_000))
+x = ca.SX.sym("x")
+claim = prove_identity("square", (x + 1) ** 2, x**2 + 2 * x + 1, [x], "all real x")
+sys.stdout.write(claim.status + " " + claim.method)
+"""
+
+
+def test_an_identity_is_still_proved_under_a_finite_hard_cpu_limit():
+    """A process started under ``ulimit -Ht`` (the hard CPU limit finite) still proves (x+1)^2 = x^2 + 2x + 1 by
+    exact rational arithmetic: the symbolic child keeps the limit instead of failing to raise it."""
+    done = subprocess.run([sys.executable, "-c", _UNDER_A_HARD_LIMIT], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("proved "), done.stdout
 
 
 def test_synthesis_keeps_equalities_on_P_and_names_its_claim():

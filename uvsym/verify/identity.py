@@ -76,9 +76,11 @@ def exact_zero(expression: sp.Expr) -> bool:
 
 def _symbolic_outcome(entries: list[sp.Expr], channel, seconds: float) -> None:
     """In the child: send "exact", "simplify" or "" (not shown to be zero) for the whole difference;
-    the child is stopped after ``seconds`` of CPU time (so a loaded machine does not change the outcome)."""
-    limit = max(1, math.ceil(seconds))
-    resource.setrlimit(resource.RLIMIT_CPU, (limit + int(time.process_time()), resource.RLIM_INFINITY))
+    the child is stopped after ``seconds`` of CPU time (so a loaded machine does not change the outcome), or
+    earlier at a finite hard limit the process inherited (a batch job's ``ulimit -t``), which it keeps."""
+    _, hard = resource.getrlimit(resource.RLIMIT_CPU)
+    soft = max(1, math.ceil(seconds)) + int(time.process_time())
+    resource.setrlimit(resource.RLIMIT_CPU, (soft if hard == resource.RLIM_INFINITY else min(soft, hard), hard))
     how = "exact"
     for entry in entries:
         if exact_zero(entry):
