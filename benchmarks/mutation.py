@@ -23,8 +23,10 @@ another sample), an estimate (``sample`` in each module's record; the others cou
 ``--keep FOLDER`` keeps the copy; ``--again FOLDER`` brings the current tests and [tool.mutmut] (its
 ``only_mutate`` kept) there and tests again only the mutants that were not killed. The tests kept there only add
 kills, so the result is that of a full run with the current tests on the source copied then: a kill that mutmut
-drops unchecked because the test selection changed is put back. ``--before --tests-at COMMIT`` records a
-baseline with an earlier commit's tests under the key ``before``.
+drops unchecked because the test selection changed is put back. The other modules' current sources come too
+(a fix elsewhere reaches the tests); a mutated module that changed must be measured afresh. ``--suspect FILE``
+also tests again the kills that may owe to a test listed there failing for another reason.
+``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests under the key ``before``.
 """
 
 from __future__ import annotations
@@ -116,6 +118,26 @@ def _write_config(scratch: Path, config: dict, modules: list[str]) -> None:
     text = (scratch / "pyproject.toml").read_text()
     text = re.sub(r"(?ms)^\[tool\.mutmut\]\n.*?(?=^\[)", lambda _: section + "\n", text)
     (scratch / "pyproject.toml").write_text(text)
+
+
+def _current_sources(scratch: Path, modules: list[str]) -> None:
+    """The working tree's uvsym/ into the kept ``scratch`` and its mutants/ (a fix elsewhere reaches the tests), the
+    mutated ``modules`` left as mutmut made them; SystemExit if one of those changed since the kept run."""
+    changed = [m for m in modules if (scratch / m).read_bytes() != (ROOT / m).read_bytes()]
+    if changed:
+        raise SystemExit(f"--again: {', '.join(changed)} changed since the kept run; measure it afresh")
+    for destination in (scratch, scratch / "mutants"):
+        _copy_listed(destination, ["uvsym"], modules if destination.name == "mutants" else [])
+
+
+def _suspect_kills(scratch: Path, modules: list[str], tests: set[str]) -> list[str]:
+    """Killed mutants of ``modules`` whose function any of ``tests`` (pytest node ids) ran, by the kept run's
+    statistics: a kill that may be those tests failing for another reason."""
+    from mutmut.stats import status_by_exit_code
+
+    ran = json.loads((scratch / "mutants" / "mutmut-stats.json").read_text())["tests_by_mangled_function_name"]
+    return sorted(name for codes in _exit_codes(scratch, modules).values() for name, code in codes.items()
+                  if status_by_exit_code[code] in KILLED and tests & set(ran.get(name.rsplit("__mutmut_", 1)[0], ())))
 
 
 def _exit_codes(scratch: Path, modules: list[str]) -> dict[str, dict[str, int | None]]:
@@ -233,6 +255,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="in a folder an earlier run kept (--keep), bring the current tests and test again only "
                              "the mutants that were not killed (tests kept there only add kills); with --sample, "
                              "only those of the sample tested there")
+    parser.add_argument("--suspect", type=Path, metavar="FILE",
+                        help="with --again: also test again the killed mutants whose function a test listed in FILE "
+                             "(pytest node ids, one per line) ran: kills that test may owe to another failure")
     parser.add_argument("--sample", type=int, metavar="N",
                         help="test N mutants of each module drawn at random (seeded by its path): an estimate, "
                              "not a full run")
@@ -259,11 +284,15 @@ def main(argv: list[str] | None = None) -> int:
         if args.again:
             for destination in (scratch, scratch / "mutants"):
                 _copy_tests(destination, args.without, args.tests_at)
+            _current_sources(scratch, modules)
+            suspect = _suspect_kills(scratch, modules, set(args.suspect.read_text().split())) if args.suspect else []
             kept_codes = _exit_codes(scratch, modules)
+            for name in suspect:  # tested again below: its verdict is the new one, not the kept kill
+                kept_codes[next(m for m in modules if name.startswith(_dotted(m)))].pop(name)
             _write_config(scratch, config, kept)
             again = {"survived", "no tests", "suspicious", "timeout"} | (set() if args.sample else {"not checked"})
-            names = sorted(n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
-                           if s in again)
+            names = sorted({n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
+                            if s in again} | set(suspect))
         else:
             _copy_tree(scratch, config, modules, args.without, args.tests_at)
         mutmut = str(Path(sys.executable).parent / "mutmut")

@@ -6,6 +6,8 @@ import json
 import tomllib
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("mutation_driver", ROOT / "benchmarks" / "mutation.py")
 mutation = importlib.util.module_from_spec(_spec)
@@ -71,3 +73,32 @@ def test_the_written_config_keeps_the_modules_and_stands_in_for_missing_selected
     assert (tmp_path / "tests" / "test_a.py").read_text().startswith("def test_a")  # an existing file is left alone
     for folder in (tmp_path, tmp_path / "mutants"):
         assert "Not in the tests measured" in (folder / "tests" / "test_new.py").read_text()
+
+
+def test_suspect_kills_are_the_kills_of_functions_a_listed_test_ran(tmp_path):
+    (tmp_path / "mutants" / "uvsym").mkdir(parents=True)
+    (tmp_path / "mutants" / "mutmut-stats.json").write_text(json.dumps({"tests_by_mangled_function_name": {
+        "uvsym.m.x_f": ["tests/a.py::t1", "tests/c.py::t3"], "uvsym.m.x_g": ["tests/b.py::t2"]}}))
+    (tmp_path / "mutants" / "uvsym" / "m.py.meta").write_text(json.dumps({"exit_code_by_key": {
+        "uvsym.m.x_f__mutmut_1": 1, "uvsym.m.x_f__mutmut_2": 0, "uvsym.m.x_f__mutmut_3": 36,
+        "uvsym.m.x_g__mutmut_1": 1, "uvsym.m.x_h__mutmut_1": 1}}))
+    # f's kills (a failure and a timeout) may owe to t1; f's survivor, g's kill (t2 only) and h (no tests) do not
+    assert mutation._suspect_kills(tmp_path, ["uvsym/m.py"], {"tests/a.py::t1"}) == [
+        "uvsym.m.x_f__mutmut_1", "uvsym.m.x_f__mutmut_3"]
+    assert mutation._suspect_kills(tmp_path, ["uvsym/m.py"], {"tests/z.py::t9"}) == []
+
+
+def test_again_brings_the_other_modules_current_sources_and_refuses_a_changed_mutated_one(tmp_path):
+    module, other = "uvsym/faults.py", "uvsym/errors.py"
+    for folder in (tmp_path, tmp_path / "mutants"):
+        (folder / "uvsym").mkdir(parents=True)
+        (folder / other).write_text("# the kept run's copy\n")
+    (tmp_path / module).write_bytes((ROOT / module).read_bytes())
+    (tmp_path / "mutants" / module).write_text("# mutmut's mutants\n")
+    mutation._current_sources(tmp_path, [module])
+    assert (tmp_path / "mutants" / module).read_text() == "# mutmut's mutants\n"
+    for folder in (tmp_path, tmp_path / "mutants"):
+        assert (folder / other).read_bytes() == (ROOT / other).read_bytes()
+    (tmp_path / module).write_text("# edited since\n")
+    with pytest.raises(SystemExit, match="uvsym/faults.py changed since the kept run"):
+        mutation._current_sources(tmp_path, [module])
