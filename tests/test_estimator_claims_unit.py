@@ -55,6 +55,9 @@ def test_sampled_decay_is_claimed_at_the_given_equilibrium_and_says_so():
     assert_proved(certificate)
     assert certificate.claim == "luenberger on twin, sampled every 0.1 s: the error map contracts (spectral radius < 1)"
     assert certificate.set == WHERE
+    rk4 = np.polynomial.Polynomial([1, 1, 1 / 2, 1 / 6, 1 / 24])
+    radius = max(abs(rk4(-0.1) - 0.3), abs(rk4(-0.2)))  # 0.6048375, 0.8187333...
+    assert certificate.details["spectral_radius"] == pytest.approx(radius, rel=1e-12)
 
 
 def test_sampled_decay_default_radius_is_one():
