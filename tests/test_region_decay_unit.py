@@ -7,6 +7,7 @@ The plants are linear (or cubic), so every expected value is derived by hand: fo
 
 import re
 from dataclasses import replace
+from fractions import Fraction
 
 import casadi as ca
 import numpy as np
@@ -17,6 +18,7 @@ from uvsym.observers.luenberger import luenberger_observer
 from uvsym.systems import signals, system
 from uvsym.testing import assert_proved, assert_refuted
 from uvsym.verify.estimators import region_decay_claim
+from uvsym.verify.region import _sqrt_above
 
 EXPANSION = ("; e' as its exact quadratic expansion (polynomial of degree <= 2 in e, e'(0) = 0 proved in exact "
              "rationals)")
@@ -119,11 +121,21 @@ def test_error_dynamics_not_zero_at_e_0_for_every_state_are_refused():
         region_decay_claim(wrong, plant, np.eye(2), gamma=1.0, half_widths=[0.5, 0.5], cube=0.05)
 
 
-@pytest.mark.xfail(strict=True, reason="region._sqrt_above(0) is 1, not 0: an exact interval Hessian (radius 0) is "
-                                       "shifted by 1, so a true claim whose W has a Hessian eigenvalue in [-1, 0) "
-                                       "comes out inconclusive (depends on the units)")
 def test_a_true_claim_with_a_small_hessian_of_w_is_proved():
-    """l = 1, P = I, gamma = 1.5: W = V' + 1.5 e'e = -2.5 e_a^2 - 0.5 e_b^2 < 0 off 0, Hessian diag(-5, -1)."""
+    """l = 1, P = I, gamma = 1.5: W = V' + 1.5 e'e = -2.5 e_a^2 - 0.5 e_b^2 < 0 off 0, Hessian diag(-5, -1). An exact
+    interval Hessian (radius 0) must not be widened by the square root's rounding (it was by 1, whatever the units)."""
     plant = _pair()
     obs = luenberger_observer(plant, [[1.0], [0.0]], 0.01)
     assert_proved(region_decay_claim(obs, plant, np.eye(2), gamma=1.5, half_widths=[0.5, 0.25], cube=0.05))
+
+
+
+@pytest.mark.parametrize("value", [Fraction(0), Fraction(1), Fraction(4, 9), Fraction(2), Fraction(1, 3),
+                                   Fraction(10**30, 7)])
+def test_the_square_root_bound_is_above_and_within_2_to_the_minus_64_over_q(value):
+    """r^2 >= value in rationals, r exact for a perfect square, and r - 2^-64 / q is below sqrt(value)."""
+    r = _sqrt_above(value)
+    lower = r - Fraction(1, value.denominator * 2**64)
+    assert r * r >= value and (lower < 0 or lower * lower < value)
+    if value in (Fraction(0), Fraction(1), Fraction(4, 9)):
+        assert r * r == value

@@ -92,9 +92,11 @@ class _Decrease:
 
 
 def _sqrt_above(value: Fraction) -> Fraction:
-    """A rational r >= sqrt(value) (value >= 0), exactly: isqrt of numerator times denominator."""
-    p, q = value.numerator, value.denominator
-    return Fraction(math.isqrt(p * q) + 1, q)
+    """A rational r >= sqrt(value) (value >= 0), exactly, less than 2^-64 / denominator above it (0 for 0):
+    sqrt(p / q) = sqrt(p q 2^128) / (q 2^64), its integer square root rounded up."""
+    scaled = (value.numerator * value.denominator) << 128
+    root = math.isqrt(scaled)
+    return Fraction(root if root * root == scaled else root + 1, value.denominator << 64)
 
 
 def _cube_certificate(decrease: _Decrease, rho: float) -> tuple[bool, Fraction | None]:
