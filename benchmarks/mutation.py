@@ -24,7 +24,7 @@ another sample), an estimate (``sample`` in each module's record; the others cou
 ``only_mutate`` kept) there and tests again only the mutants that were not killed. The tests kept there only add
 kills, so the result is that of a full run with the current tests on the source copied then: a kill that mutmut
 drops unchecked because the test selection changed is put back. The other modules' current sources come too
-(a fix elsewhere reaches the tests); a mutated module that changed must be measured afresh. ``--suspect FILE``
+(a fix elsewhere reaches the tests); a mutated module that changed is left out (measure it afresh). ``--suspect FILE``
 also tests again the kills that may owe to a test listed there failing for another reason.
 ``--before --tests-at COMMIT`` records a baseline with an earlier commit's tests under the key ``before``.
 """
@@ -120,14 +120,17 @@ def _write_config(scratch: Path, config: dict, modules: list[str]) -> None:
     (scratch / "pyproject.toml").write_text(text)
 
 
-def _current_sources(scratch: Path, modules: list[str]) -> None:
+def _current_sources(scratch: Path, modules: list[str]) -> list[str]:
     """The working tree's uvsym/ into the kept ``scratch`` and its mutants/ (a fix elsewhere reaches the tests), the
-    mutated ``modules`` left as mutmut made them; SystemExit if one of those changed since the kept run."""
+    mutated ``modules`` left as mutmut made them; those that changed since the kept run come unmutated, as they are
+    now, and are not measured (measure them afresh). Returns the modules still measured."""
     changed = [m for m in modules if (scratch / m).read_bytes() != (ROOT / m).read_bytes()]
     if changed:
-        raise SystemExit(f"--again: {', '.join(changed)} changed since the kept run; measure it afresh")
+        print(f"--again: {', '.join(changed)} changed since the kept run, not measured here: measure afresh")
+    measured = [m for m in modules if m not in changed]
     for destination in (scratch, scratch / "mutants"):
-        _copy_listed(destination, ["uvsym"], modules if destination.name == "mutants" else [])
+        _copy_listed(destination, ["uvsym"], measured if destination.name == "mutants" else [])
+    return measured
 
 
 def _suspect_kills(scratch: Path, modules: list[str], tests: set[str]) -> list[str]:
@@ -284,12 +287,14 @@ def main(argv: list[str] | None = None) -> int:
         if args.again:
             for destination in (scratch, scratch / "mutants"):
                 _copy_tests(destination, args.without, args.tests_at)
-            _current_sources(scratch, modules)
+            modules = _current_sources(scratch, modules)
+            if not modules:
+                parser.error(f"--again: every module {args.again} measured changed since; measure them afresh")
             suspect = _suspect_kills(scratch, modules, set(args.suspect.read_text().split())) if args.suspect else []
             kept_codes = _exit_codes(scratch, modules)
             for name in suspect:  # tested again below: its verdict is the new one, not the kept kill
                 kept_codes[next(m for m in modules if name.startswith(_dotted(m)))].pop(name)
-            _write_config(scratch, config, kept)
+            _write_config(scratch, config, modules)
             again = {"survived", "no tests", "suspicious", "timeout"} | (set() if args.sample else {"not checked"})
             names = sorted({n for statuses in _outcomes(scratch, modules).values() for n, s in statuses.items()
                             if s in again} | set(suspect))
