@@ -243,7 +243,8 @@ def _tally(scratch: Path, module: str, statuses: dict[str, str], equivalents: di
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--modules", nargs="+", help="globs or paths of modules to mutate (default: all configured)")
+    parser.add_argument("--modules", nargs="+", help="globs or paths of modules to mutate (default: all configured; "
+                                                      "with --again: those of the kept run)")
     parser.add_argument("--max-children", type=int, default=1, help="mutants tested at once (default 1: shared cores)")
     parser.add_argument("--results", type=Path, default=RESULTS,
                         help="the results file to write (and to merge into); default benchmarks/results/mutation.json")
@@ -273,7 +274,8 @@ def main(argv: list[str] | None = None) -> int:
     available = configured_modules(config)
     if args.again:
         kept = tomllib.loads((args.again / "pyproject.toml").read_text())["tool"]["mutmut"]["only_mutate"]
-        modules = [m for m in available if m in kept]
+        modules = [m for m in available if m in kept and (not args.modules or any(
+            fnmatch.fnmatch(m, p) or m == p for p in args.modules))]
     else:
         modules = available if not args.modules else [m for m in available if any(
             fnmatch.fnmatch(m, p) or m == p for p in args.modules)]
