@@ -1,0 +1,152 @@
+"""Unit tests of ``prove_identity``'s outcomes: the certificate's fields, the sampled evidence (count, seed,
+box, zero scales, mpmath evaluation) and the re-check that turns a large sampled difference into a refutation.
+
+Expected values come from exact fractions of the double constants or from hand computation; claims are tiny
+(one or two symbols) so that each proof takes well under a second.
+"""
+
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+
+import casadi as ca
+import numpy as np
+
+from uvsym.verify import prove_identity
+from uvsym.verify.identity import _points
+
+SAMPLED = ("sampled: 30 points over {where}, mpmath 50 digits, each entry against the size of its terms, to the "
+           "precision of the model's double constants (evidence, not a proof)")
+
+
+def test_an_exact_proof_fills_every_field_of_its_certificate():
+    x = ca.SX.sym("x")
+    before = time.perf_counter()
+    certificate = prove_identity("x (x + 1) = x^2 + x", x * (x + 1), x ** 2 + x, [x], "all x", expected="refuted",
+                                 symbolic_seconds=1.0)
+    elapsed = time.perf_counter() - before
+    assert certificate.claim == "x (x + 1) = x^2 + x" and certificate.set == "all x"
+    assert certificate.status == "proved" and certificate.expected == "refuted"
+    assert certificate.method == ("exact rational arithmetic on the double constants (converted exactly), "
+                                  "transcendental terms as independent symbols: the difference is zero")
+    assert isinstance(certificate.seconds, float) and 0.0 < certificate.seconds <= elapsed
+
+
+def test_a_proof_by_simplification_says_so():
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")  # exp(x), exp(y), exp(x + y) are independent atoms to the exact step
+    certificate = prove_identity("e^x e^y = e^(x + y)", ca.exp(x) * ca.exp(y), ca.exp(x + y), [x, y], "all x, y",
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "proved"
+    assert certificate.method == "sympy simplification to zero, rational constants (exact)"
+
+
+def test_sampling_evaluates_thirty_points_against_the_size_of_the_terms():
+    # x (1 + 1e-13) - x over |x (1 + 1e-13)| + |x|: the same relative difference (a - 1) / (a + 1) at every x != 0,
+    # with a the double 1 + 1e-13 taken exactly
+    x = ca.SX.sym("x")
+    certificate = prove_identity("near", x * (1 + 1e-13), x, [x], "all x", symbolic_seconds=1.0)
+    a = Fraction(1 + 1e-13)
+    assert certificate.status == "checked" and certificate.reason == "not shown zero symbolically"
+    assert certificate.method == SAMPLED.format(where="the reals at scales 1e-3 to 1e8")
+    assert certificate.details["points"] == 30
+    assert certificate.details["largest_relative_difference"] == float((a - 1) / (a + 1))
+
+
+def test_the_default_seed_is_zero_and_the_seed_moves_the_points():
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")
+    lhs, rhs = x * (1 + 1e-13) + y, x + y  # relative difference 1e-13 |x| / (2 |x| + 2 |y|): depends on the point
+    default = prove_identity("near", lhs, rhs, [x, y], "all x, y", symbolic_seconds=1.0)
+    zero = prove_identity("near", lhs, rhs, [x, y], "all x, y", seed=0, symbolic_seconds=1.0)
+    one = prove_identity("near", lhs, rhs, [x, y], "all x, y", seed=1, symbolic_seconds=1.0)
+    assert default.status == zero.status == one.status == "checked"
+    assert default.details == zero.details
+    assert one.details["largest_relative_difference"] != zero.details["largest_relative_difference"]
+
+
+def test_a_box_is_sampled_instead_of_the_reals():
+    # |x| = x holds on [1, 2] only: sampling the reals would meet x < 0 and refute it
+    x = ca.SX.sym("x")
+    certificate = prove_identity("|x| = x", ca.fabs(x), x, [x], "1 <= x <= 2", box=([1.0], [2.0]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "checked"
+    assert certificate.method == SAMPLED.format(where="the stated box")
+
+
+def test_a_point_where_both_sides_and_their_size_vanish_counts_as_no_difference():
+    # at x = 0 the difference and its scale are both exactly 0: relative difference 0, not 0 / 0
+    x = ca.SX.sym("x")
+    certificate = prove_identity("near", x * (1 + 1e-13), x, [x], "x = 0", box=([0.0], [0.0]), symbolic_seconds=1.0)
+    assert certificate.status == "checked"
+    assert certificate.details == {"largest_relative_difference": 0.0, "points": 30}
+
+
+def test_a_sample_point_at_a_pole_is_skipped_and_sampling_goes_on():
+    # (1 + 1e-13) / x against 1 / x over [0, 1]: the points at x = 0 (a box end) are not evaluable
+    x = ca.SX.sym("x")
+    certificate = prove_identity("near", (1 + 1e-13) / x, 1 / x, [x], "0 <= x <= 1", box=([0.0], [1.0]),
+                                 symbolic_seconds=1.0)
+    poles = int(np.sum(_points(np.random.default_rng(0), 1, (np.zeros(1), np.ones(1)), 30)[:, 0] == 0.0))
+    assert 0 < poles < 29 and certificate.status == "checked"
+    assert certificate.details["points"] == 30 - poles
+
+
+def test_transcendental_terms_are_evaluated_with_mpmath():
+    x = ca.SX.sym("x")
+    certificate = prove_identity("near", ca.sin(x) * (1 + 1e-13), ca.sin(x), [x], "all x", symbolic_seconds=1.0)
+    a = Fraction(1 + 1e-13)
+    assert certificate.status == "checked" and certificate.details["points"] == 30
+    assert certificate.details["largest_relative_difference"] == float((a - 1) / (a + 1))
+
+
+def _scaled(gap: float):
+    """a x against x at the single point x = 1.126, with a = 1 + gap / 1.126: the difference is ~gap and the size
+    of the terms (a + 1) 1.126 ~ 2.252, so a refutation needs gap > 2e-10 * 2.252 = 4.504e-10."""
+    x = ca.SX.sym("x")
+    return prove_identity("a x = x", (1 + gap / 1.126) * x, x, [x], "x = 1.126", box=([1.126], [1.126]),
+                          symbolic_seconds=1.0)
+
+
+def test_a_gap_above_twice_the_threshold_is_refuted_by_intervals():
+    certificate = _scaled(4.75e-10)  # 4.75e-10 > 4.504e-10 (but below 3e-10 * 2.252 and 2e-10 * 2.5)
+    assert certificate.status == "refuted"
+    assert certificate.method == ("mpmath evaluation at 50 digits, entry 0 against the size of its terms; "
+                                  "re-checked by interval evaluation (outward rounding)")
+
+
+def test_a_gap_below_twice_the_threshold_is_not_refuted():
+    certificate = _scaled(4.3e-10)  # relative 4.3e-10 / 2.252 = 1.9e-10 > 1e-10, yet 4.3e-10 < 4.504e-10
+    assert certificate.status == "inconclusive"
+
+
+def test_without_intervals_a_difference_is_confirmed_at_a_hundred_digits():
+    # tan has no interval evaluation; relative difference 1e-9 / (2 + 1e-9) = 5e-10 > 1e-10, lost at low precision
+    x = ca.SX.sym("x")
+    certificate = prove_identity("tan", ca.tan(x) * (1 + 1e-9), ca.tan(x), [x], "x = 0.5", box=([0.5], [0.5]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "refuted"
+    assert certificate.method == ("mpmath evaluation at 50 digits, entry 0 against the size of its terms; "
+                                  "confirmed at 100 digits")
+
+
+def _cancelling(x):
+    """(x + 1)^2 - x^2 - 2 x - 1: zero, but at x = 1e30 rounded away from zero at 50 digits (not at 100)."""
+    return (x + 1) ** 2 - x ** 2 - 2 * x - 1
+
+
+def test_without_intervals_a_rounding_artefact_is_not_refuted():
+    # (1 + 1e-13) / (D + 1) against 1 with D = 0 exactly: relative difference ~5e-14 at 100 digits, ~1 at 50
+    # digits (where D is large); tan (on both sides) leaves intervals out
+    x = ca.SX.sym("x")
+    lhs = (1 + 1e-13) / (_cancelling(x) + 1) + ca.tan(x)
+    certificate = prove_identity("artefact", lhs, 1 + ca.tan(x), [x], "x = 1e30", box=([1e30], [1e30]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "inconclusive"
+
+
+def test_a_recheck_that_fails_to_evaluate_is_not_a_refutation():
+    # 1 / D with D = 0 exactly: finite at 50 digits, a division by zero at 100
+    x = ca.SX.sym("x")
+    certificate = prove_identity("artefact", 1 / _cancelling(x), ca.SX(0), [x], "x = 1e30", box=([1e30], [1e30]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "inconclusive"
