@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from uvsym.verify.identity import _points
 
@@ -113,3 +114,40 @@ def test_free_points_scaled_part_is_log_uniform_from_1e_minus_3_to_1e8_with_both
     small = values[(values != 0) & (np.abs(values) < 1e-2)]
     expected = 0.35 / 11 + 0.5 * math.erf(0.005 / math.sqrt(2.0))
     assert abs(small.size / values.size - expected) < 0.005
+
+
+class _Draws:
+    """A generator stand-in: each uniform draw is the next given fraction of [low, high), in call order."""
+
+    def __init__(self, fractions):
+        self.fractions = iter(fractions)
+
+    def uniform(self, low=0.0, high=1.0, size=None):
+        return low + (high - low) * np.full(size, next(self.fractions))
+
+    def normal(self, size=None):
+        return np.full(size, 0.25)
+
+    def integers(self, low, high, size=None):
+        return np.full(size, low + 3)
+
+
+@pytest.mark.parametrize("choice, expected", [(0.0, 0.0), (0.59, 0.0), (0.6, 3.0), (0.7, 3.0), (0.8, 0.003)])
+def test_box_points_put_a_draw_on_a_boundary_in_the_next_share(choice, expected):
+    """Draws lie on [0, 1): half-open shares [0, 0.6), [0.6, 0.8), [0.8, 1) and end halves [0, 0.5), [0.5, 1)
+    are exactly 60/20/20 % and 1/2 each. Box [-1, 3]: uniform fraction 1/4 -> 0; ends fraction 1/2 -> upper 3;
+    sign fraction 3/4 -> +1; exponent fraction 1/2 -> 10^-3 * max(1, 3) = 0.003."""
+    draws = _Draws([0.25, 0.5, 0.75, 0.5, choice])
+    point = _points(draws, 1, (np.array([-1.0]), np.array([3.0])), 1)
+    assert point.shape == (1, 1)
+    assert point[0, 0] == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("choice, expected", [(0.49, 0.5), (0.5, 10.0 ** 2.5), (0.84, 10.0 ** 2.5), (0.85, -7.0)])
+def test_free_points_put_a_draw_on_a_boundary_in_the_next_share(choice, expected):
+    """Shares [0, 0.5) normal, [0.5, 0.85) scaled, [0.85, 1) integers. Normal 0.25 * 2 = 0.5; sign fraction
+    3/4 -> +1, exponent fraction 1/2 of [-3, 8) -> 10^2.5; integer -10 + 3 = -7."""
+    draws = _Draws([0.75, 0.5, choice])
+    point = _points(draws, 1, None, 1)
+    assert point.shape == (1, 1)
+    assert point[0, 0] == pytest.approx(expected, rel=1e-12)
