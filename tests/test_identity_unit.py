@@ -150,3 +150,29 @@ def test_a_recheck_that_fails_to_evaluate_is_not_a_refutation():
     certificate = prove_identity("artefact", 1 / _cancelling(x), ca.SX(0), [x], "x = 1e30", box=([1e30], [1e30]),
                                  symbolic_seconds=1.0)
     assert certificate.status == "inconclusive"
+
+
+def test_a_refutation_names_the_entry_and_the_point_by_the_symbols_names():
+    # entry 0 agrees, entry 1 is 2 x against x: relative difference |2 x - x| / (2 |x| + |x|) = 1/3 at x = 3;
+    # the symbol's name "p.x" is no Python identifier
+    x = ca.SX.sym("p.x")
+    certificate = prove_identity("(x, 2 x) = (x, x)", ca.vertcat(x, 2 * x), ca.vertcat(x, x), [x], "x = 3",
+                                 expected="refuted", box=([3.0], [3.0]), symbolic_seconds=1.0)
+    assert certificate.status == "refuted" and certificate.margin == -1 / 3
+    assert certificate.counterexample == {"point": {"p.x": 3.0}, "entry": 1, "relative_difference": 1 / 3}
+    assert certificate.method.startswith("mpmath evaluation at 50 digits, entry 1 against the size of its terms; ")
+
+
+def test_a_gap_exactly_at_twice_the_threshold_is_not_refuted():
+    # x + z against z at x = 2^-33, z = (S - 2^-33) / 2: the difference is x exactly (an exact interval), the size
+    # of the terms x + 2 z = S exactly, and S is the double with 2e-10 * S rounding to 2^-33: a tie, not above it
+    gap = 2.0 ** -33
+    size = min((gap / 2e-10 + i * np.spacing(gap / 2e-10) for i in range(-20, 21)),
+               key=lambda s: abs(2e-10 * s - gap))
+    assert 2e-10 * size == gap
+    z = (size - gap) / 2
+    assert Fraction(gap) + 2 * Fraction(z) == Fraction(size)
+    x, y = ca.SX.sym("x"), ca.SX.sym("z")
+    certificate = prove_identity("tie", x + y, y, [x, y], "one point", box=([gap, z], [gap, z]), symbolic_seconds=1.0)
+    assert certificate.status == "inconclusive"
+    assert certificate.margin == -float(Fraction(gap) / Fraction(size))
