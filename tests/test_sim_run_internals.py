@@ -179,6 +179,27 @@ def test_the_interpreted_fast_path_rolls_its_own_mapaccum_named_for_the_loop(mon
     assert calls == [("closed_loop_roll", 3)]
 
 
+def test_the_interpreted_fast_path_rolls_a_shorter_last_chunk_with_a_mapaccum_of_its_own(monkeypatch):
+    """Chunk 3, then a last chunk of 2 rows from an integer z = 7: logs 7, 8 and ends at 9 (7 read as a float,
+    not its bytes); the 2-row roll is a second mapaccum of 2 steps under the same name."""
+    loop = _counter()
+    calls = []
+
+    class Step:
+        def mapaccum(self, name, n):
+            calls.append((name, n))
+            return loop.step.mapaccum(name, n)
+
+    _fake_compiler(monkeypatch, None, None)
+    before = run.time.perf_counter()
+    advance, build_s = run._stepper(SimpleNamespace(step=Step(), n_z=1, plant_ode=None), "fast", 3, {}, True)
+    assert 0.0 <= build_s <= run.time.perf_counter() - before
+    out = np.empty((2, 1))
+    np.testing.assert_array_equal(advance(np.array([7]), np.zeros((2, 1)), out), [9.0])
+    np.testing.assert_array_equal(out[:, 0], [7.0, 8.0])
+    assert calls == [("closed_loop_roll", 3), ("closed_loop_roll", 2)]
+
+
 def test_a_failed_compilation_warns_at_the_runs_caller_and_runs_interpreted(monkeypatch):
     """The counter from z = 0 over 3 samples logs 0, 1, 2 and 3 (the last from the discrete part)."""
 
