@@ -120,32 +120,35 @@ def test_a_gap_below_twice_the_threshold_is_not_refuted():
 
 
 def test_without_intervals_a_difference_is_confirmed_at_a_hundred_digits():
-    # tan has no interval evaluation; relative difference 1e-9 / (2 + 1e-9) = 5e-10 > 1e-10, lost at low precision
+    # (x + 1e-9)^2 against x^2 at x = 0.5: difference ~1e-9, size of the terms 0.5^2 + 0.5^2 + 2 tan(0.5) ~ 1.59, so
+    # a relative difference ~6.3e-10 > 1e-10 (lost at low precision, where x + 1e-9 rounds to x); tan (on both
+    # sides, cancelled in the difference) leaves intervals out
     x = ca.SX.sym("x")
-    certificate = prove_identity("tan", ca.tan(x) * (1 + 1e-9), ca.tan(x), [x], "x = 0.5", box=([0.5], [0.5]),
-                                 symbolic_seconds=1.0)
+    certificate = prove_identity("square", (x + 1e-9) ** 2 + ca.tan(x), x ** 2 + ca.tan(x), [x], "x = 0.5",
+                                 box=([0.5], [0.5]), symbolic_seconds=1.0)
     assert certificate.status == "refuted"
     assert certificate.method == ("mpmath evaluation at 50 digits, entry 0 against the size of its terms; "
                                   "confirmed at 100 digits")
 
 
 def _cancelling(x):
-    """(x + 1)^2 - x^2 - 2 x - 1: zero, but at x = 1e30 rounded away from zero at 50 digits (not at 100)."""
+    """(x + 1)^2 - x^2 - 2 x - 1: zero, but -1 at x = 1e30 and 50 digits (where (x + 1)^2, 200 bits, loses its
+    last term), exactly 0 at 100 digits."""
     return (x + 1) ** 2 - x ** 2 - 2 * x - 1
 
 
 def test_without_intervals_a_rounding_artefact_is_not_refuted():
-    # (1 + 1e-13) / (D + 1) against 1 with D = 0 exactly: relative difference ~5e-14 at 100 digits, ~1 at 50
-    # digits (where D is large); tan (on both sides) leaves intervals out
+    # (1 + 1e-13) / (D + 2) against 1/2: relative difference ~5e-14 at 100 digits (D = 0), 1/3 at 50 digits
+    # (D = -1); tan (on both sides, cancelled in the difference) leaves intervals out
     x = ca.SX.sym("x")
-    lhs = (1 + 1e-13) / (_cancelling(x) + 1) + ca.tan(x)
-    certificate = prove_identity("artefact", lhs, 1 + ca.tan(x), [x], "x = 1e30", box=([1e30], [1e30]),
+    lhs = (1 + 1e-13) / (_cancelling(x) + 2) + ca.tan(x)
+    certificate = prove_identity("artefact", lhs, 0.5 + ca.tan(x), [x], "x = 1e30", box=([1e30], [1e30]),
                                  symbolic_seconds=1.0)
     assert certificate.status == "inconclusive"
 
 
 def test_a_recheck_that_fails_to_evaluate_is_not_a_refutation():
-    # 1 / D with D = 0 exactly: finite at 50 digits, a division by zero at 100
+    # 1 / D against 0: relative difference 1 at 50 digits (D = -1), a division by zero at 100 (D = 0)
     x = ca.SX.sym("x")
     certificate = prove_identity("artefact", 1 / _cancelling(x), ca.SX(0), [x], "x = 1e30", box=([1e30], [1e30]),
                                  symbolic_seconds=1.0)
