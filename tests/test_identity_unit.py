@@ -12,6 +12,7 @@ from fractions import Fraction
 
 import casadi as ca
 import numpy as np
+import pytest
 
 from uvsym.verify import prove_identity
 from uvsym.verify.identity import _points
@@ -179,3 +180,15 @@ def test_a_gap_exactly_at_twice_the_threshold_is_not_refuted():
     certificate = prove_identity("tie", x + y, y, [x, y], "one point", box=([gap, z], [gap, z]), symbolic_seconds=1.0)
     assert certificate.status == "inconclusive"
     assert certificate.margin == -float(Fraction(gap) / Fraction(size))
+
+
+@pytest.mark.xfail(strict=True, reason="without intervals, a refutation is 'confirmed' by one evaluation at 100 digits "
+                                       "which a cancellation beyond 100 digits fools")
+def test_without_intervals_a_cancellation_beyond_a_hundred_digits_is_not_a_refutation():
+    # (1 + 1e-13) / (D + 2) against 1/2 at x = 1e60: D is exactly 0 (relative difference 5e-14, below rounding), but
+    # (x + 1)^2 takes 400 bits: D is -1 at 100 digits (1/3 "confirmed") and exact only from 121 digits on
+    x = ca.SX.sym("x")
+    lhs = (1 + 1e-13) / (_cancelling(x) + 2) + ca.tan(x)
+    certificate = prove_identity("artefact", lhs, 0.5 + ca.tan(x), [x], "x = 1e60", box=([1e60], [1e60]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status != "refuted"
