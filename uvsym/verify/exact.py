@@ -29,11 +29,13 @@ def as_fraction_matrix(matrix, name: str = "matrix") -> Matrix:
 
     VerificationError naming ``name`` for non-finite entries or a matrix that is not 2-D.
     """
-    if isinstance(matrix, list) and matrix and all(isinstance(v, Fraction) for row in matrix for v in row):
+    if (isinstance(matrix, list) and matrix and all(isinstance(row, list) for row in matrix) and matrix[0]
+            and len({len(row) for row in matrix}) == 1
+            and all(isinstance(v, Fraction) for row in matrix for v in row)):
         return [list(row) for row in matrix]
     try:
         array = np.atleast_2d(np.asarray(matrix, dtype=float))
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise VerificationError(f"{name} must be a numeric matrix: {exc}") from None
     if array.ndim != 2 or array.size == 0:
         raise VerificationError(f"{name} must be a non-empty 2-D matrix, got shape {array.shape}")
