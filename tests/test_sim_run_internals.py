@@ -161,16 +161,20 @@ def test_the_fast_path_is_compiled_only_when_asked_and_a_compiler_is_there(monke
         assert compiled == [] and callable(advance)
 
 
-def test_the_interpreted_fast_path_rolls_its_own_mapaccum_named_for_the_loop(monkeypatch):
-    """The counter from z = 2 over 3 samples logs 2, 3, 4 and ends at 5."""
-    loop = _counter()
-    calls = []
-
+def _recording_step(loop, calls):
+    """A stand-in for ``loop.step`` whose mapaccum records (name, n) in ``calls`` and builds the real one."""
     class Step:
         def mapaccum(self, name, n):
             calls.append((name, n))
             return loop.step.mapaccum(name, n)
 
+    return Step
+
+
+def test_the_interpreted_fast_path_rolls_its_own_mapaccum_named_for_the_loop(monkeypatch):
+    """The counter from z = 2 over 3 samples logs 2, 3, 4 and ends at 5."""
+    loop, calls = _counter(), []
+    Step = _recording_step(loop, calls)
     _fake_compiler(monkeypatch, None, None)
     advance, _ = run._stepper(SimpleNamespace(step=Step(), n_z=1, plant_ode=None), "fast", 3, {}, True)
     out = np.empty((3, 1))
@@ -182,14 +186,8 @@ def test_the_interpreted_fast_path_rolls_its_own_mapaccum_named_for_the_loop(mon
 def test_the_interpreted_fast_path_rolls_a_shorter_last_chunk_with_a_mapaccum_of_its_own(monkeypatch):
     """Chunk 3, then a last chunk of 2 rows from an integer z = 7: logs 7, 8 and ends at 9 (7 read as a float,
     not its bytes); the 2-row roll is a second mapaccum of 2 steps under the same name."""
-    loop = _counter()
-    calls = []
-
-    class Step:
-        def mapaccum(self, name, n):
-            calls.append((name, n))
-            return loop.step.mapaccum(name, n)
-
+    loop, calls = _counter(), []
+    Step = _recording_step(loop, calls)
     _fake_compiler(monkeypatch, None, None)
     before = run.time.perf_counter()
     advance, build_s = run._stepper(SimpleNamespace(step=Step(), n_z=1, plant_ode=None), "fast", 3, {}, True)
