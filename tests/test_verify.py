@@ -465,3 +465,26 @@ def test_convergence_claims_keep_the_expected_status_they_are_given():
     claim = convergence_claim("Toy", _toy_observer("proportional"), [3.0, 3.0], 0.5, 2.0, 1.0)
     assert (claim.status, claim.expected, claim.as_expected) == ("refuted", "proved", False)
     assert claim.counterexample["eigenvalue_real"] == pytest.approx(-0.75)  # the slowest rate, 3 * 0.5^2, < gamma
+
+
+def test_error_dynamics_claims_keep_the_expected_status_and_the_stated_symbols():
+    from types import SimpleNamespace
+
+    from uvsym.verify.observers import error_dynamics_claim
+
+    varying = error_dynamics_claim("Toy", _toy_observer("bias"), constant_tau_d=False, expected="refuted")
+    assert (varying.status, varying.expected, varying.as_expected) == ("refuted", "refuted", True)
+    # derived e' = -2 K e against the claimed -K e: false for tau_d constant too, and the counterexample names only
+    # the symbols of the constant-tau_d set (no tau_d'); the size n = 2 comes from tau_d, K being a 1 x 2 row
+    e, f, eta, nu, tau_d, tau_d_dot = (ca.SX.sym(v, 2) for v in ("e", "f", "eta", "nu", "tau_d", "tau_d_dot"))
+    K = ca.SX.sym("K", 1, 2)
+    wrong = SimpleNamespace(kind="bias", form="toy", model_name="two channels",
+                            error_matrix=ca.Function("A", [tau_d, K], [-ca.diag(K)]),
+                            error_dynamics=ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K],
+                                                       [-2 * ca.mtimes(ca.diag(K), e)]))
+    refuted = error_dynamics_claim("Toy", wrong, expected="refuted")
+    assert (refuted.status, refuted.expected) == ("refuted", "refuted")
+    point = refuted.counterexample["point"]
+    assert sorted(point) == sorted(f"{name}_{i}" for name in ("e", "f", "eta", "nu", "tau_d", "K") for i in range(2))
+    # the difference of the two sides, -K e, is nonzero at the counterexample
+    assert max(abs(point["K_0"] * point["e_0"]), abs(point["K_1"] * point["e_1"])) > 0
