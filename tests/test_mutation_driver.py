@@ -6,6 +6,8 @@ import json
 import tomllib
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("mutation_driver", ROOT / "benchmarks" / "mutation.py")
 mutation = importlib.util.module_from_spec(_spec)
@@ -43,6 +45,7 @@ def test_every_equivalent_names_one_mutant_of_a_mutated_module_with_its_change_a
 
 
 def test_again_puts_back_only_the_kills_mutmut_dropped_unchecked(tmp_path):
+    pytest.importorskip("mutmut", reason="mutmut (the [mutation] extra) reads the exit codes")
     # exit codes: 1 killed, 36 timeout (a kill), 0 survived, None not checked (mutmut's convention)
     meta = tmp_path / "mutants" / "uvsym" / "m.py.meta"
     meta.parent.mkdir(parents=True)
@@ -74,6 +77,7 @@ def test_the_written_config_keeps_the_modules_and_stands_in_for_missing_selected
 
 
 def test_suspect_kills_are_the_kills_of_functions_a_listed_test_ran(tmp_path):
+    pytest.importorskip("mutmut", reason="mutmut (the [mutation] extra) reads the exit codes")
     (tmp_path / "mutants" / "uvsym").mkdir(parents=True)
     (tmp_path / "mutants" / "mutmut-stats.json").write_text(json.dumps({"tests_by_mangled_function_name": {
         "uvsym.m.x_f": ["tests/a.py::t1", "tests/c.py::t3"], "uvsym.m.x_g": ["tests/b.py::t2"]}}))
