@@ -11,11 +11,13 @@ import time
 from fractions import Fraction
 
 import casadi as ca
+import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 
 from uvsym.verify import prove_identity
-from uvsym.verify.identity import _points
+from uvsym.verify.identity import _interval_enclosures, _points
 
 SAMPLED = ("sampled: 30 points over {where}, mpmath 50 digits, each entry against the size of its terms, to the "
            "precision of the model's double constants (evidence, not a proof)")
@@ -120,16 +122,16 @@ def test_a_gap_below_twice_the_threshold_is_not_refuted():
     assert certificate.status == "inconclusive"
 
 
-def test_without_intervals_a_difference_is_confirmed_at_a_hundred_digits():
+def test_where_the_graph_lacks_intervals_mpmath_interval_arithmetic_confirms_a_difference():
     # (x + 1e-9)^2 against x^2 at x = 0.5: difference ~1e-9, size of the terms 0.5^2 + 0.5^2 + 2 tan(0.5) ~ 1.59, so
     # a relative difference ~6.3e-10 > 1e-10 (lost at low precision, where x + 1e-9 rounds to x); tan (on both
-    # sides, cancelled in the difference) leaves intervals out
+    # sides, cancelled in the difference) leaves the CasADi graph's intervals out, not mpmath's
     x = ca.SX.sym("x")
     certificate = prove_identity("square", (x + 1e-9) ** 2 + ca.tan(x), x ** 2 + ca.tan(x), [x], "x = 0.5",
                                  box=([0.5], [0.5]), symbolic_seconds=1.0)
     assert certificate.status == "refuted"
     assert certificate.method == ("mpmath evaluation at 50 digits, entry 0 against the size of its terms; "
-                                  "confirmed at 100 digits")
+                                  "re-checked by mpmath interval arithmetic at 100 digits (outward rounding)")
 
 
 def _cancelling(x):
@@ -182,16 +184,16 @@ def test_a_gap_exactly_at_twice_the_threshold_is_not_refuted():
     assert certificate.margin == -float(Fraction(gap) / Fraction(size))
 
 
-@pytest.mark.xfail(strict=True, reason="without intervals, a refutation is 'confirmed' by one evaluation at 100 digits "
-                                       "which a cancellation beyond 100 digits fools")
-def test_without_intervals_a_cancellation_beyond_a_hundred_digits_is_not_a_refutation():
+def test_without_the_graphs_intervals_a_cancellation_beyond_a_hundred_digits_is_not_a_refutation():
     # (1 + 1e-13) / (D + 2) against 1/2 at x = 1e60: D is exactly 0 (relative difference 5e-14, below rounding), but
-    # (x + 1)^2 takes 400 bits: D is -1 at 100 digits (1/3 "confirmed") and exact only from 121 digits on
+    # (x + 1)^2 takes 400 bits: D is -1 at 50 and at 100 digits (a relative difference of 1/3 at one evaluation);
+    # mpmath intervals at 100 digits hold D + 2 in an interval around 0, and from 121 digits on D is exactly 0
     x = ca.SX.sym("x")
     lhs = (1 + 1e-13) / (_cancelling(x) + 2) + ca.tan(x)
     certificate = prove_identity("artefact", lhs, 0.5 + ca.tan(x), [x], "x = 1e60", box=([1e60], [1e60]),
                                  symbolic_seconds=1.0)
-    assert certificate.status != "refuted"
+    assert certificate.status == "inconclusive" and certificate.margin < -0.1
+    assert certificate.reason.endswith("is above 1e-10 at 50 digits, not confirmed by the interval re-check")
 
 
 def test_without_intervals_a_relative_difference_exactly_at_the_threshold_is_not_confirmed():
@@ -229,13 +231,74 @@ def test_a_sampled_relative_difference_exactly_at_the_threshold_is_not_rechecked
     assert certificate.status == "inconclusive" and certificate.margin == -1e-10
 
 
-@pytest.mark.xfail(strict=True, reason="the re-check's size of the terms is one evaluation at 100 digits, which a "
-                                       "cancellation beyond 100 digits inflates")
 def test_a_size_of_the_terms_inflated_by_a_cancellation_beyond_a_hundred_digits_does_not_hide_a_refutation():
-    # (2 + 6.8e-10) y - y + sin(D) at y = 1, x = 1e60: exactly 1 + 6.8e-10 (D = 0), size 3 + 6.8e-10; intervals bound
-    # the difference below by 6.8e-10 (sin(D) in [-1, 1]) > 2e-10 * 3: a refutation; at 100 digits D = -1 adds
-    # |sin(-1)| = 0.84 to the size and 2e-10 * 3.84 = 7.7e-10 hides it
+    # (2 + 6.8e-10) y - y + sin(D) at y = 1, x = 1e60: exactly 1 + 6.8e-10 (D = 0), size 3 + 6.8e-10; the graph's
+    # intervals bound the difference below by 6.8e-10 (sin(D) in [-1, 1]) > 2e-10 * 3: a refutation; one evaluation
+    # at 100 digits (D = -1) adds |sin(-1)| = 0.84 to the size and 2e-10 * 3.84 = 7.7e-10 would hide it; intervals at
+    # 100 digits bound the size by 4 + 6.8e-10 (too loose), at 200 digits by 3 + 6.8e-10
     x, y = ca.SX.sym("x"), ca.SX.sym("y")
     certificate = prove_identity("false", (2 + 6.8e-10) * y + ca.sin(_cancelling(x)), y, [x, y], "one point",
                                  box=([1e60, 1.0], [1e60, 1.0]), symbolic_seconds=1.0)
     assert certificate.status == "refuted"
+
+
+def _sine_of_cancelling(at: float):
+    """(2 + 6.8e-10) y + sin(D) against y at y = 1: false (the difference is 1 + 6.8e-10), refutable by the
+    graph's gap bound 6.8e-10 once the size of the terms is bounded by less than 3.4 (it is 3 + 6.8e-10), which
+    takes the digits of (x + 1)^2 at x = ``at``: 2 log10(at) of them."""
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")
+    return prove_identity("false", (2 + 6.8e-10) * y + ca.sin(_cancelling(x)), y, [x, y], "one point",
+                          box=([at, 1.0], [at, 1.0]), symbolic_seconds=1.0)
+
+
+def test_the_recheck_raises_its_precision_to_four_hundred_digits_and_no_further():
+    assert _sine_of_cancelling(1e150).status == "refuted"  # 300 digits needed
+    beyond = _sine_of_cancelling(1e250)  # 500 digits needed
+    assert beyond.status == "inconclusive" and "not confirmed by the interval re-check" in beyond.reason
+
+
+FUNCTIONS = {"asin": (sp.asin, mpmath.asin), "acos": (sp.acos, mpmath.acos), "atan": (sp.atan, mpmath.atan),
+             "sinh": (sp.sinh, mpmath.sinh), "cosh": (sp.cosh, mpmath.cosh), "tanh": (sp.tanh, mpmath.tanh),
+             "sin": (sp.sin, mpmath.sin), "cos": (sp.cos, mpmath.cos), "tan": (sp.tan, mpmath.tan),
+             "exp": (sp.exp, mpmath.exp), "log": (sp.log, mpmath.log),
+             "atan2": (lambda a: sp.atan2(a, -2), lambda a: mpmath.atan2(a, -2)),
+             "cube root": (lambda a: a ** sp.Rational(1, 3), mpmath.cbrt),
+             "pi, e": (lambda a: sp.pi * a + sp.E, lambda a: mpmath.pi * a + mpmath.e),
+             "abs": (lambda a: sp.Abs(a - 1), lambda a: abs(a - 1))}
+
+
+@pytest.mark.parametrize("name", FUNCTIONS)
+@pytest.mark.parametrize("at", [0.3, 0.9990234375])
+def test_mpmath_intervals_enclose_each_function_tightly(name, at):
+    symbolic, reference = FUNCTIONS[name]
+    x = sp.Symbol("x", real=True)
+    (enclosure,) = _interval_enclosures([x], [symbolic(x)], [at], 100)
+    with mpmath.workdps(130):
+        exact = reference(mpmath.mpf(at))
+        assert enclosure.a <= exact <= enclosure.b
+        assert enclosure.b - enclosure.a < mpmath.mpf(10) ** -95
+
+
+@pytest.mark.parametrize("expression, at", [("log(x)", -1.0), ("asin(x)", 2.0), ("acos(x)", -1.5), ("sqrt(x)", -4.0),
+                                                ("x**(1/3)", -8.0), ("x**(3/2)", -4.0)])
+def test_an_interval_evaluation_outside_the_domain_gives_no_enclosure(expression, at):
+    x = sp.Symbol("x", real=True)
+    assert _interval_enclosures([x], [sp.sympify(expression, locals={"x": x})], [at], 100) is None
+
+
+def test_an_interval_through_a_pole_is_unbounded():
+    x = sp.Symbol("x", real=True)
+    (enclosure,) = _interval_enclosures([x], [1 / x], [0.0], 100)
+    assert enclosure.a == -mpmath.inf and enclosure.b == mpmath.inf
+
+
+@pytest.mark.parametrize("operation", [lambda a: ca.fmin(a, 1), ca.sign, ca.floor])
+def test_an_operation_without_an_interval_extension_is_never_refuted(operation):
+    # 2 op(x) against op(x) at x = 1.5 (op(x) = 1): relative difference 1/3, plainly false, but min, sign and floor
+    # have no outward-rounded mpmath extension (Python's min on intervals would even pick a side): inconclusive
+    x = ca.SX.sym("x")
+    certificate = prove_identity("2 op = op", 2 * operation(x), operation(x), [x], "x = 1.5", box=([1.5], [1.5]),
+                                 symbolic_seconds=1.0)
+    assert certificate.status == "inconclusive" and certificate.margin == -1 / 3
+    assert certificate.reason == ("not shown zero symbolically; largest relative difference 0.333 is above 1e-10 at "
+                                  "50 digits, not confirmed by the interval re-check")

@@ -14,12 +14,14 @@ Otherwise the difference is sampled with mpmath at ``DIGITS`` significant digits
 the claim's stated set (its ``box``; without one, at scales from 1e-3 to 1e8 besides N(0, 2^2)
 and small integers). Each entry is measured against its own scale, the sum of the absolute values
 of the terms of its two sides (what the rounding of the model's double constants can move it by).
-An entry above ``REFUTE`` (1e-10) refutes the claim once re-checked without mpmath's rounding: an
-outward-rounded interval evaluation of the CasADi graph at the point must bound the gap above
-twice the threshold (where the graph has an operation intervals lack, a re-evaluation at
-``2 DIGITS`` digits, said so in the method). Every entry below ``ROUNDING`` (1e-12) at every point
-makes the claim ``checked`` (numerical evidence at N points, never a proof); anything between is
-inconclusive.
+An entry above ``REFUTE`` (1e-10) refutes the claim once re-checked rigorously at the point: a lower
+bound of the gap must exceed twice the threshold times an upper bound of the size of the terms. The
+size is bounded by mpmath interval arithmetic (outward rounding, at ``RECHECK_DIGITS`` digits, each
+tried in turn); the gap by an outward-rounded interval evaluation of the CasADi graph, or, where the
+graph has an operation those intervals lack, by mpmath interval arithmetic on the converted entry
+(said so in the method). An entry with an operation neither has (``INTERVAL_FUNCTIONS``) is never
+refuted. Every entry below ``ROUNDING`` (1e-12) at every point makes the claim ``checked``
+(numerical evidence at N points, never a proof); anything between is inconclusive.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ import casadi as ca
 import mpmath
 import numpy as np
 import sympy as sp
+from sympy.printing.pycode import MpmathPrinter
 
 from uvsym.errors import VerificationError
 from uvsym.sympy_bridge import to_sympy
@@ -42,6 +45,7 @@ from uvsym.verify.interval import IntervalFunction
 __all__ = ["prove_identity", "exact_zero"]
 
 DIGITS = 50
+RECHECK_DIGITS = (100, 200, 400)  # precisions of the interval re-check, tried in turn until one decides
 REFUTE, ROUNDING = 1e-10, 1e-12
 SYMBOLIC_SECONDS = 4.0  # CPU seconds of the symbolic steps
 WALL_FACTOR = 20  # wall-clock allowance of a loaded machine, per CPU second
@@ -182,6 +186,50 @@ def _certain_gap(lhs: ca.SX, rhs: ca.SX, symbols: list[ca.SX], point, k: int) ->
     return float(max(lo, -hi, 0.0)) if bounds.defined[0] else 0.0
 
 
+def _interval_functions() -> dict:
+    """sympy function -> its outward-rounded mpmath interval extension (``mpmath.iv``): the functions iv has,
+    and others by identities that hold wherever the function is defined (any interval extension of such a
+    formula encloses the function)."""
+    iv = mpmath.iv
+    return {sp.sin: iv.sin, sp.cos: iv.cos, sp.tan: iv.tan, sp.exp: iv.exp, sp.log: iv.ln, sp.atan2: iv.atan2,
+            sp.atan: lambda a: iv.atan2(a, iv.mpf(1)), sp.asin: lambda a: iv.atan2(a, iv.sqrt((1 - a) * (1 + a))),
+            sp.acos: lambda a: iv.atan2(iv.sqrt((1 - a) * (1 + a)), a),
+            sp.sinh: lambda a: (iv.exp(a) - iv.exp(-a)) / 2, sp.cosh: lambda a: (iv.exp(a) + iv.exp(-a)) / 2,
+            sp.tanh: lambda a: 1 - 2 / (iv.exp(2 * a) + 1)}
+
+
+INTERVAL_FUNCTIONS = _interval_functions()
+_INTERVAL_NODES = (sp.Symbol, sp.Rational, sp.Add, sp.Mul, sp.Pow, sp.Abs, type(sp.pi), type(sp.E))
+
+
+def _interval_evaluable(expression: sp.Expr) -> bool:
+    """Whether every operation of ``expression`` has an outward-rounded interval extension (no Min, sign, ...)."""
+    return all(isinstance(node, _INTERVAL_NODES) or node.func in INTERVAL_FUNCTIONS
+               for node in sp.preorder_traversal(expression))
+
+
+def _interval_enclosures(symbols: list[sp.Symbol], expressions: list[sp.Expr], point, digits: int):
+    """Intervals (``mpmath.iv.mpf``) enclosing each expression at the point, by mpmath interval arithmetic at
+    ``digits`` digits; None where an expression has an operation without an interval extension, where the
+    evaluation fails (a domain edge) or where it is complex."""
+    if not all(_interval_evaluable(e) for e in expressions):
+        return None
+    namespace = {"mpf": mpmath.iv.mpf, "pi": mpmath.iv.pi, "e": mpmath.iv.e,
+                 **{f.__name__: extension for f, extension in INTERVAL_FUNCTIONS.items()}}
+    printer = MpmathPrinter({"fully_qualified_modules": False, "inline": True, "allow_unknown_functions": False})
+    evaluate = sp.lambdify(symbols, expressions, modules=[namespace], printer=printer)
+    precision = mpmath.iv.prec
+    try:
+        mpmath.iv.dps = digits
+        values = evaluate(*[mpmath.iv.mpf(float(p)) for p in point])
+        enclosures = [mpmath.iv.mpf(v) if isinstance(v, int) else v for v in values]
+        return enclosures if all(isinstance(v, mpmath.iv.mpf) for v in enclosures) else None  # not complex
+    except (ZeroDivisionError, ValueError, TypeError, OverflowError, mpmath.libmp.ComplexResult):
+        return None
+    finally:
+        mpmath.iv.prec = precision
+
+
 def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_description: str,
                    expected: str = "proved", samples: int = 30, seed: int = 0, box=None,
                    symbolic_seconds: float = SYMBOLIC_SECONDS) -> Certificate:
@@ -212,7 +260,8 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
         return certificate("sympy simplification to zero, rational constants (exact)", "proved")
     sym = [sp.Symbol(s.name(), real=True) for s in symbols]
     numeric = sp.lambdify(sym, entries, modules="mpmath")
-    magnitude = sp.lambdify(sym, [_magnitude(a) + _magnitude(b) for a, b in zip(left, right)], modules="mpmath")
+    sizes = [_magnitude(a) + _magnitude(b) for a, b in zip(left, right)]
+    magnitude = sp.lambdify(sym, sizes, modules="mpmath")
 
     def relative(point, digits):
         with mpmath.workdps(digits):
@@ -222,17 +271,19 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
                     for v, s in zip(values, scales)]
 
     def _recheck(point, k) -> str:
-        """How the gap at the point was re-checked ("" when it was not confirmed)."""
-        try:
-            with mpmath.workdps(2 * DIGITS):
-                scale = magnitude(*[mpmath.mpf(float(p)) for p in point])[k]
-            fine = relative(point, 2 * DIGITS)[k] > REFUTE
-        except (ZeroDivisionError, ValueError, TypeError, OverflowError):
-            return ""
-        gap = _certain_gap(lhs, rhs, symbols, point, k)
-        if gap is None:
-            return f"confirmed at {2 * DIGITS} digits" if fine else ""
-        return "re-checked by interval evaluation (outward rounding)" if gap > 2 * REFUTE * float(scale) else ""
+        """How the gap at the point was bounded rigorously above twice the threshold ("" when it was not)."""
+        graph_gap = _certain_gap(lhs, rhs, symbols, point, k)
+        for digits in RECHECK_DIGITS:
+            bounds = _interval_enclosures(sym, [entries[k], sizes[k]], point, digits)
+            if bounds is None:
+                return ""
+            gap, size = bounds
+            threshold = (2 * REFUTE * size.b).b  # rounded up
+            if graph_gap is not None and graph_gap > threshold:
+                return "re-checked by interval evaluation (outward rounding)"
+            if max(gap.a, -gap.b) > threshold:
+                return f"re-checked by mpmath interval arithmetic at {digits} digits (outward rounding)"
+        return ""
 
     rng = np.random.default_rng(seed)
     worst, evaluated = 0.0, 0
@@ -256,8 +307,9 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
     if evaluated == 0:
         return certificate(method, "inconclusive", reason=f"{reason}no sample point was evaluable")
     if worst > ROUNDING:
+        level = (f"above {REFUTE:g} at {DIGITS} digits, not confirmed by the interval re-check" if worst > REFUTE
+                 else f"above rounding but below {REFUTE:g}")
         return certificate(method, "inconclusive", margin=-worst,
-                           reason=f"{reason}largest relative difference {worst:.3g} is above rounding but below "
-                                  f"{REFUTE:g}")
+                           reason=f"{reason}largest relative difference {worst:.3g} is {level}")
     return certificate(method, "checked", margin=ROUNDING - worst, reason=reason.rstrip("; "),
                        details={"largest_relative_difference": worst, "points": evaluated})
