@@ -17,9 +17,9 @@ of the terms of its two sides (what the rounding of the model's double constants
 An entry above ``REFUTE`` (1e-10) refutes the claim once re-checked rigorously at the point: a lower
 bound of the gap must exceed twice the threshold times an upper bound of the size of the terms. The
 size is bounded by mpmath interval arithmetic (outward rounding, at ``RECHECK_DIGITS`` digits, each
-tried in turn); the gap by an outward-rounded interval evaluation of the CasADi graph, or, where the
-graph has an operation those intervals lack, by mpmath interval arithmetic on the converted entry
-(said so in the method). An entry with an operation neither has (``INTERVAL_FUNCTIONS``) is never
+tried in turn, ``mp_enclosure``); the gap by an outward-rounded interval evaluation of the CasADi
+graph, or, where the graph has an operation those intervals lack, by mpmath interval arithmetic on the
+converted entry (said so in the method). An entry that mpmath's intervals cannot enclose is never
 refuted. Every entry below ``ROUNDING`` (1e-12) at every point makes the claim ``checked``
 (numerical evidence at N points, never a proof); anything between is inconclusive.
 """
@@ -35,12 +35,12 @@ import casadi as ca
 import mpmath
 import numpy as np
 import sympy as sp
-from sympy.printing.pycode import MpmathPrinter
 
 from uvsym.errors import VerificationError
 from uvsym.sympy_bridge import to_sympy
 from uvsym.verify.certificate import Certificate
 from uvsym.verify.interval import IntervalFunction
+from uvsym.verify.mp_enclosure import enclose
 
 __all__ = ["prove_identity", "exact_zero"]
 
@@ -186,50 +186,6 @@ def _certain_gap(lhs: ca.SX, rhs: ca.SX, symbols: list[ca.SX], point, k: int) ->
     return float(max(lo, -hi, 0.0)) if bounds.defined[0] else 0.0
 
 
-def _interval_functions() -> dict:
-    """sympy function -> its outward-rounded mpmath interval extension (``mpmath.iv``): the functions iv has,
-    and others by identities that hold wherever the function is defined (any interval extension of such a
-    formula encloses the function)."""
-    iv = mpmath.iv
-    return {sp.sin: iv.sin, sp.cos: iv.cos, sp.tan: iv.tan, sp.exp: iv.exp, sp.log: iv.ln, sp.atan2: iv.atan2,
-            sp.atan: lambda a: iv.atan2(a, iv.mpf(1)), sp.asin: lambda a: iv.atan2(a, iv.sqrt((1 - a) * (1 + a))),
-            sp.acos: lambda a: iv.atan2(iv.sqrt((1 - a) * (1 + a)), a),
-            sp.sinh: lambda a: (iv.exp(a) - iv.exp(-a)) / 2, sp.cosh: lambda a: (iv.exp(a) + iv.exp(-a)) / 2,
-            sp.tanh: lambda a: 1 - 2 / (iv.exp(2 * a) + 1)}
-
-
-INTERVAL_FUNCTIONS = _interval_functions()
-_INTERVAL_NODES = (sp.Symbol, sp.Rational, sp.Add, sp.Mul, sp.Pow, sp.Abs, type(sp.pi), type(sp.E))
-
-
-def _interval_evaluable(expression: sp.Expr) -> bool:
-    """Whether every operation of ``expression`` has an outward-rounded interval extension (no Min, sign, ...)."""
-    return all(isinstance(node, _INTERVAL_NODES) or node.func in INTERVAL_FUNCTIONS
-               for node in sp.preorder_traversal(expression))
-
-
-def _interval_enclosures(symbols: list[sp.Symbol], expressions: list[sp.Expr], point, digits: int):
-    """Intervals (``mpmath.iv.mpf``) enclosing each expression at the point, by mpmath interval arithmetic at
-    ``digits`` digits; None where an expression has an operation without an interval extension, where the
-    evaluation fails (a domain edge) or where it is complex."""
-    if not all(_interval_evaluable(e) for e in expressions):
-        return None
-    namespace = {"mpf": mpmath.iv.mpf, "pi": mpmath.iv.pi, "e": mpmath.iv.e,
-                 **{f.__name__: extension for f, extension in INTERVAL_FUNCTIONS.items()}}
-    printer = MpmathPrinter({"fully_qualified_modules": False, "inline": True, "allow_unknown_functions": False})
-    evaluate = sp.lambdify(symbols, expressions, modules=[namespace], printer=printer)
-    precision = mpmath.iv.prec
-    try:
-        mpmath.iv.dps = digits
-        values = evaluate(*[mpmath.iv.mpf(float(p)) for p in point])
-        enclosures = [mpmath.iv.mpf(v) if isinstance(v, int) else v for v in values]
-        return enclosures if all(isinstance(v, mpmath.iv.mpf) for v in enclosures) else None  # not complex
-    except (ZeroDivisionError, ValueError, TypeError, OverflowError, mpmath.libmp.ComplexResult):
-        return None
-    finally:
-        mpmath.iv.prec = precision
-
-
 def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_description: str,
                    expected: str = "proved", samples: int = 30, seed: int = 0, box=None,
                    symbolic_seconds: float = SYMBOLIC_SECONDS) -> Certificate:
@@ -274,7 +230,7 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
         """How the gap at the point was bounded rigorously above twice the threshold ("" when it was not)."""
         graph_gap = _certain_gap(lhs, rhs, symbols, point, k)
         for digits in RECHECK_DIGITS:
-            bounds = _interval_enclosures(sym, [entries[k], sizes[k]], point, digits)
+            bounds = enclose([entries[k], sizes[k]], dict(zip(sym, point)), digits)
             if bounds is None:
                 return ""
             gap, size = bounds
