@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from uvsym.errors import VerificationError
-from uvsym.verify.region import _cube_certificate, _Decrease, _taylor_cube
+from uvsym.verify import region
+from uvsym.verify.region import _branch_and_bound, _cube_certificate, _Decrease, _taylor_cube
 
 
 def _one(expression):
@@ -133,3 +134,121 @@ def test_taylor_cube_needs_W_itself_to_vanish_at_zero_not_only_its_gradient():
     cube, pivot, why = _taylor_cube(_one(lambda x: 1 - x * x), 0.5)
     assert (cube, pivot) == (0.5 / 64, None)
     assert why.startswith("W or its gradient at x = 0 is not exactly 0 in interval arithmetic")
+
+
+# ---------------------------------------------------------------- branch-and-bound bookkeeping
+
+CLAIM = "W = V' + gamma x'x stays negative on the whole test box"
+
+
+class _Bar:
+    """Stands in for ProgressBar: keeps the label and every fraction drawn."""
+
+    def __init__(self, label):
+        self.label, self.fractions, self.closed = label, [], False
+
+    def __call__(self, fraction):
+        self.fractions.append(fraction)
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.fixture
+def bars(monkeypatch):
+    """The progress bars the search opens (in order), recorded instead of drawn."""
+    opened = []
+
+    def bar(label):
+        opened.append(_Bar(label))
+        return opened[-1]
+
+    monkeypatch.setattr(region, "ProgressBar", bar)
+    return opened
+
+
+def _search(expression, lower, upper, cube, max_boxes=50, batch=8192):
+    """_branch_and_bound of W(x) = expression(x), one state labelled x, on [lower, upper] outside |x| <= cube."""
+    return _branch_and_bound(_one(expression), np.array([lower], dtype=float), np.array([upper], dtype=float),
+                             cube, np.array([1.0]), max_boxes, batch, CLAIM, ("x",))
+
+
+def test_search_one_box_at_a_time_counts_boxes_and_reports_progress_in_fractions_of_the_box(bars):
+    """W = -x^2 on [-1, 3] outside |x| <= 1/4, one box per batch (breadth first, left halves first). Boxes
+    holding 0 have the upper bound 0 (not < 0) and are halved; the others are proved by the plain form.
+    [-1, 3], [-1, 1] undecided; [1, 3] proved (1/2 of the box); [-1, 0], [0, 1] undecided; [-1, -1/2] proved
+    (5/8); [-1/2, 0], [0, 1/2] undecided; [1/2, 1], [-1/2, -1/4] proved; [-1/4, 0], [0, 1/4] inside the cube;
+    [1/4, 1/2] proved: 11 boxes outside the cube, the worst bound -sq(1/4) = -1/16 (on [-1/2, -1/4] and
+    [1/4, 1/2]). The bar is drawn after each undecided box: 0, 0, 1/2, 1/2, 5/8, 5/8."""
+    search = _search(lambda x: -x * x, -1, 3, 0.25, batch=1)
+    assert search["boxes"] == 11 and set(search) == {"boxes", "worst"}
+    assert -1 / 16 <= search["worst"] <= -1 / 16 + 1e-12
+    (bar,) = bars
+    assert bar.label == "branch-and-bound W = V' + gamma x'x stays negative on the"
+    assert bar.fractions == [0.0, 0.0, 0.5, 0.5, 0.625, 0.625]
+    assert bar.closed
+
+
+def test_search_counts_boxes_on_the_cube_s_boundary_as_settled(bars):
+    """W = -x^2 + 2 x - x - x (summed left to right: 2 x - x - x is 0, but its plain interval is not) on
+    [-1/2, 3/2] outside |x| <= 1/2, one box per batch. [-1/2, 3/2]: plain hi 4, mean value -1/4 + 3 * 1 > 0,
+    halved. [-1/2, 1/2] lies in the cube (its ends on the cube's faces): half the box settled. [1/2, 3/2]:
+    mean value -1 + 3 / 2 > 0, halved, drawn at 1/2. [1/2, 1]: -9/16 + 2 / 4 = -1/16; [1, 3/2]:
+    -25/16 + 3 / 4 = -13/16. 4 boxes, worst -1/16, drawn 0 and 1/2."""
+    search = _search(lambda x: -x * x + 2 * x - x - x, -0.5, 1.5, 0.5, batch=1)
+    assert search["boxes"] == 4 and set(search) == {"boxes", "worst"}
+    assert -1 / 16 <= search["worst"] <= -1 / 16 + 1e-12
+    assert bars[0].fractions == [0.0, 0.5]
+
+
+def test_search_sums_the_shares_of_the_boxes_proved_together(bars):
+    """W = -x^2 on [-1, 1] outside |x| <= 1/4, all boxes of a level in one batch: [-1, 1]; [-1, 0], [0, 1];
+    then [-1, -1/2] and [1/2, 1] are proved together (1/4 + 1/4 of the box) while [0, 1/2], [-1/2, 0] are
+    halved; the last level is proved or in the cube. 1 + 2 + 4 + 2 = 9 boxes, drawn at 0, 0, 1/2."""
+    search = _search(lambda x: -x * x, -1, 1, 0.25)
+    assert search["boxes"] == 9 and set(search) == {"boxes", "worst"}
+    assert -1 / 16 <= search["worst"] <= -1 / 16 + 1e-12
+    assert bars[0].fractions == [0.0, 0.0, 0.5]
+
+
+@pytest.mark.parametrize("max_boxes, expected", [(6, {"boxes": 7, "open": "0 <= x <= 0.5"}), (7, {"boxes": 9})])
+def test_search_stops_once_more_than_max_boxes_were_bounded(bars, max_boxes, expected):
+    """The previous search bounds 1, 3, 7, 9 boxes in its four batches. With max_boxes 6 it stops after the
+    third (7 > 6), naming the first undecided box of that batch, [0, 1/2] (the batch is [-1, -1/2], [0, 1/2],
+    [-1/2, 0], [1/2, 1]); with max_boxes 7 it goes on (7 is not more than 7) and proves the claim."""
+    search = _search(lambda x: -x * x, -1, 1, 0.25, max_boxes=max_boxes)
+    assert {key: search[key] for key in expected} == expected
+    assert set(search) == set(expected) | ({"worst"} if "open" not in expected else set())
+
+
+def test_search_halves_each_box_along_its_widest_side_relative_to_the_scale(bars):
+    """W = -a^2 - b^2 on a in [-1, 1], b in [-2, 2] with scale (1, 4): relative widths (2, 1), so the first box
+    is halved along a. Stopped after that (3 boxes > max_boxes 1), the first open box is its left half."""
+    v = ca.SX.sym("v", 2)
+    search = _branch_and_bound(_Decrease(-v[0] * v[0] - v[1] * v[1], v), np.array([-1.0, -2.0]),
+                               np.array([1.0, 2.0]), 0.25, np.array([1.0, 4.0]), 1, 8192, CLAIM, ("a", "b"))
+    assert search == {"boxes": 3, "open": "-1 <= a <= 0, -2 <= b <= 2"}
+
+
+def test_search_returns_the_box_centre_where_W_is_positive(bars):
+    """W = 3/4 - (x - 1)^2 on [-1, 3]: the first box is not proved and W(1) = 3/4 > 0 at its centre."""
+    search = _search(lambda x: 0.75 - (x - 1) ** 2, -1, 3, 0.25, max_boxes=20)
+    assert search["boxes"] == 1 and search["counterexample"].tolist() == [1.0]
+
+
+def test_search_returns_the_first_centre_where_W_may_be_undefined(bars):
+    """W = -x^2 - sqrt(1 - x) on [-1, 3]: the box reaches x > 1 (undefined), its centre 1 does not (W = -1).
+    Halves [-1, 1] (defined, upper bound 0, centre 0 with W = -1) and [1, 3] (undefined, centre 2 too): the
+    search stops at x = 2 after 3 boxes."""
+    search = _search(lambda x: -x * x - ca.sqrt(1 - x), -1, 3, 0.25, max_boxes=20)
+    assert search["boxes"] == 3 and search["undefined"].tolist() == [2.0]
+
+
+def test_search_does_not_count_an_upper_bound_of_exactly_zero_as_proved(bars):
+    """W = -|x| on [-1, 1] outside |x| <= 1/4: every box with an end at 0 has the exact upper bound 0 (|.| and
+    negation are exact), which does not prove W < 0; they are halved down to the cube. Boxes: [-1, 1];
+    [-1, 0], [0, 1]; [-1, -1/2] and [1/2, 1] proved, [0, 1/2], [-1/2, 0] halved; [-1/2, -1/4] and [1/4, 1/2]
+    proved with bound -1/4: 9 boxes, worst -1/4."""
+    search = _search(lambda x: -ca.fabs(x), -1, 1, 0.25)
+    assert search["boxes"] == 9 and set(search) == {"boxes", "worst"}
+    assert -0.25 <= search["worst"] <= -0.25 + 1e-12
