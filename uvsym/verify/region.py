@@ -65,7 +65,8 @@ class _Decrease:
             centre = 0.5 * (lo + hi)
             at_centre = self.W(centre, centre)
             slope = self.grad(lo, hi)
-            half = round_up(np.maximum(hi - centre, centre - lo))
+            # a side of width 0 (its centre exact) has half-width 0, not rounded up: its slope never counts
+            half = np.where((lo == hi) & (centre == lo), 0.0, round_up(np.maximum(hi - centre, centre - lo)))
             steep = np.maximum(np.abs(slope.lo), np.abs(slope.hi))
             with np.errstate(all="ignore"):
                 spread = np.zeros(len(lo))
