@@ -144,3 +144,76 @@ def test_sin_reaches_one_only_where_the_box_holds_a_peak():
         assert mpmath.sin(1.2) < result.hi[0, 0] < mpmath.sin(1.2) + 1e-15
         assert mpmath.sin(-1.2) - 1e-15 < result.lo[1, 0] < mpmath.sin(-1.2)
     assert result.hi[2, 0] == 1.0 and result.lo[3, 0] == -1.0
+
+
+# --- non-smooth operations: bounds, and a kink only where it lies inside the box ---------------------------------
+
+def table(build, rows):
+    """Check ``build`` against rows of (box, lo, hi, smooth): one box per row."""
+    result = run(build, *[row[0] for row in rows])
+    got = list(zip(result.lo[:, 0].tolist(), result.hi[:, 0].tolist(), result.smooth.tolist()))
+    assert got == [row[1:] for row in rows]
+
+
+def test_fabs_bounds_and_kink():
+    # |x| is smooth on a box that only touches 0; the lower bound is the distance of the box from 0
+    table(lambda x: ca.fabs(x[0]), [
+        ((1.0, 2.0), 1.0, 2.0, True), ((0.5, 1.0), 0.5, 1.0, True), ((0.0, 1.0), 0.0, 1.0, True),
+        ((-1.0, 0.0), 0.0, 1.0, True), ((-2.0, -1.0), 1.0, 2.0, True), ((-1.0, 2.0), 0.0, 2.0, False),
+        ((-2.0, 0.5), 0.0, 2.0, False)])
+
+
+def test_fabs_of_zero_is_positive_zero():
+    result = run(lambda x: ca.fabs(x[0]), (0.0, 0.0))
+    assert result.lo[0, 0] == 0.0 and not np.signbit(result.lo[0, 0])  # IEEE fabs(+0) = +0
+
+
+def test_sign_bounds_and_kink():
+    # sign jumps at 0: a box holding 0 and any other point has a kink (a point box [0, 0] has none)
+    table(lambda x: ca.sign(x[0]), [
+        ((-1.0, 1.0), -1.0, 1.0, False), ((1.0, 2.0), 1.0, 1.0, True), ((-2.0, -1.0), -1.0, -1.0, True),
+        ((0.0, 1.0), 0.0, 1.0, False), ((-1.0, 0.0), -1.0, 0.0, False), ((0.5, 1.0), 1.0, 1.0, True),
+        ((-1.0, 0.5), -1.0, 1.0, False), ((0.0, 0.0), 0.0, 0.0, True)])
+
+
+def test_floor_and_ceil_bounds_and_kink():
+    table(lambda x: ca.floor(x[0]), [((0.5, 0.7), 0.0, 0.0, True), ((0.5, 1.5), 0.0, 1.0, False)])
+    table(lambda x: ca.ceil(x[0]), [((0.5, 0.7), 1.0, 1.0, True), ((0.5, 1.5), 1.0, 2.0, False)])
+
+
+def test_fmin_and_fmax_have_a_kink_where_the_boxes_meet():
+    # boxes (x0, x1): one inside the other either way round, touching at 1, and apart
+    rows = [((0.0, 1.0), (3.0, 2.0)), ((1.0, 0.0), (2.0, 3.0)), ((0.0, 1.0), (1.0, 2.0)), ((0.0, 2.0), (1.0, 3.0))]
+    table(lambda x: ca.fmin(x[0], x[1]), [
+        (rows[0], 0.0, 2.0, False), (rows[1], 0.0, 2.0, False), (rows[2], 0.0, 1.0, False),
+        (rows[3], 0.0, 1.0, True)])
+    table(lambda x: ca.fmax(x[0], x[1]), [
+        (rows[0], 1.0, 3.0, False), (rows[1], 1.0, 3.0, False), (rows[2], 1.0, 2.0, False),
+        (rows[3], 2.0, 3.0, True)])
+
+
+# --- logic: boxes of a condition that is certainly nonzero, certainly zero, or either ----------------------------
+
+TRUTH_BOXES = {"nonzero": (0.5, 2.0), "negative": (-2.0, -1.0), "zero": (0.0, 0.0), "either": (-1.0, 1.0)}
+TRUTH_SETS = {"nonzero": {True}, "negative": {True}, "zero": {False}, "either": {False, True}}
+
+
+@pytest.mark.parametrize(("build", "connective"), [(ca.logic_and, all), (ca.logic_or, any)], ids=["and", "or"])
+def test_logic_connectives_follow_three_valued_logic(build, connective):
+    """The result over a pair of boxes is the set of truth values over every choice of the operands' truth
+    values: 0 and 1 both possible make [0, 1] and a kink."""
+    rows = []
+    for a, b in [(a, b) for a in TRUTH_BOXES for b in TRUTH_BOXES]:
+        values = {connective((p, q)) for p in TRUTH_SETS[a] for q in TRUTH_SETS[b]}
+        box = ((TRUTH_BOXES[a][0], TRUTH_BOXES[b][0]), (TRUTH_BOXES[a][1], TRUTH_BOXES[b][1]))
+        rows.append((box, float(min(values)), float(max(values)), len(values) == 1))
+    table(lambda x: build(x[0], x[1]), rows)
+
+
+def test_if_else_zero_is_the_value_the_zero_or_their_hull():
+    # if_else(c, v, 0): v where c is certainly nonzero, 0 where c is certainly 0, the hull of v and 0 otherwise
+    table(lambda x: ca.if_else(x[0], x[1], 0), [
+        (((1.0, 1.0), (1.0, 2.0)), 1.0, 2.0, True), (((1.0, -2.0), (1.0, -1.0)), -2.0, -1.0, True),
+        (((0.0, 1.0), (0.0, 2.0)), 0.0, 0.0, True), (((0.0, -2.0), (0.0, -1.0)), 0.0, 0.0, True),
+        (((0.0, -2.0), (1.0, 0.5)), -2.0, 0.5, False), (((0.0, 1.0), (1.0, 2.0)), 0.0, 2.0, False),
+        (((0.0, -2.0), (1.0, -1.0)), -2.0, 0.0, False)])
