@@ -276,3 +276,19 @@ def test_a_difference_through_a_decided_branch_is_refuted_by_mpmath_intervals(op
                                  box=([1.5], [1.5]), symbolic_seconds=1.0)
     assert certificate.status == "refuted"
     assert certificate.method.endswith("re-checked by mpmath interval arithmetic at 100 digits (outward rounding)")
+
+
+def test_a_rational_function_is_shown_nonzero_without_simplification(monkeypatch):
+    # x (1 + 1e-13) + y - x - y is the rational function 1e-13 x (the double's excess, exactly): its nonzero numerator
+    # settles it, so sympy.simplify (made to fail here, in the forked child too) is never reached; e^x e^y against
+    # e^(x + y) still needs it (and fails with it here)
+    def refuse(*args, **kwargs):
+        raise RuntimeError("simplify called")
+
+    monkeypatch.setattr("sympy.simplify", refuse)
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")
+    rational = prove_identity("near", x * (1 + 1e-13) + y, x + y, [x, y], "all x, y", symbolic_seconds=1.0)
+    assert rational.status == "checked" and rational.reason == "not shown zero symbolically"
+    exponential = prove_identity("e^x e^y = e^(x + y)", ca.exp(x) * ca.exp(y), ca.exp(x + y), [x, y], "all x, y",
+                                 symbolic_seconds=1.0)
+    assert exponential.status == "checked" and exponential.reason == "symbolic steps over 1 s"
