@@ -24,8 +24,8 @@ TINY = np.nextafter(0.0, 1.0)  # the smallest positive double: one ulp above 0
 
 
 def run(build, *bounds):
-    """Bounds of ``build(x)`` (x a symbolic 2-vector) over the boxes given as ((lo0, lo1), (hi0, hi1)) pairs;
-    a float instead of a pair is a box of x0 with x1 = [0, 0]."""
+    """Bounds of ``build(x)`` (x a symbolic 2-vector) over boxes given as ((lo0, lo1), (hi0, hi1)); a (lo, hi)
+    pair of floats is the box [lo, hi] of x0 with x1 = [0, 0]."""
     x = ca.SX.sym("x", 2)
     pairs = [((b[0], 0.0), (b[1], 0.0)) if np.isscalar(b[0]) else b for b in bounds]
     lo = np.array([p[0] for p in pairs], dtype=float)
@@ -130,9 +130,9 @@ def test_library_functions_move_libm_ulps_outward(build, exact):
     further out, and they enclose the exact values."""
     result = run(lambda x: build(x[0]), (2.0, 4.0))
     lo, hi = result.lo[0, 0], result.hi[0, 0]
-    library = {"lo": float(exact(2)), "hi": float(exact(4))}  # correctly rounded: within an ulp of the library
-    assert abs(ulps_between(lo, library["lo"]) - LIBM_ULPS) <= 1
-    assert abs(ulps_between(library["hi"], hi) - LIBM_ULPS) <= 1
+    at_2, at_4 = float(exact(2)), float(exact(4))  # correctly rounded: within an ulp of the library's values
+    assert abs(ulps_between(lo, at_2) - LIBM_ULPS) <= 1
+    assert abs(ulps_between(at_4, hi) - LIBM_ULPS) <= 1
     with mpmath.workdps(40):
         assert mpmath.mpf(lo) < exact(2) and exact(4) < mpmath.mpf(hi)
 
