@@ -71,7 +71,7 @@ def _outside_domain(op: int, args) -> np.ndarray | None:
     if op == ca.OP_INV:
         return holds_zero(a)
     if op in (ca.OP_CONSTPOW, ca.OP_POW):
-        exponent = float(args[1][0][0]) if len(args[1][0]) else 0.0
+        exponent = float(args[1][0][0])
         if exponent == np.floor(exponent):
             return holds_zero(a) if exponent < 0 else None
         return a[0] <= 0 if exponent < 0 else a[0] < 0
@@ -139,6 +139,8 @@ class IntervalFunction:
         work: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         out_lo, out_hi = np.zeros((k, self.n_out)), np.zeros((k, self.n_out))
         smooth, defined = np.ones(k, dtype=bool), np.ones(k, dtype=bool)
+        if k == 0:  # no box: nothing to evaluate (a power reads its exponent from the first box)
+            return Intervals(out_lo, out_hi, smooth, defined)
         for op, inputs, outputs, constant in self.program:
             if op == ca.OP_INPUT:
                 work[outputs[0]] = (lo[:, inputs[1]], hi[:, inputs[1]])
