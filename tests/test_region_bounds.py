@@ -96,6 +96,16 @@ def test_upper_bound_skips_sides_of_width_zero_in_the_mean_value_form():
     assert -1.0 <= bound[0] <= -1.0 + 1e-12
 
 
+def test_a_box_one_ulp_wide_whose_centre_rounds_to_its_lower_end_keeps_its_half_width():
+    """W = 1e20 (x - 1) on [1, 1 + 2^-52]: the centre 1 + 2^-53 rounds (to even) onto the lower end, where W is 0, yet
+    the box has width: the bound must hold at the upper end, 1e20 2^-52 = 22,204.46... exactly."""
+    v = ca.SX.sym("v")
+    hi = np.nextafter(1.0, 2.0)
+    assert 0.5 * (1.0 + hi) == 1.0
+    bound = _Decrease(1e20 * (v - 1), v).upper_bound(*_box((1.0, hi)))
+    assert Fraction(bound[0]) >= Fraction(1e20) * (Fraction(hi) - 1)
+
+
 def test_upper_bound_is_infinite_and_silent_where_the_mean_value_products_overflow():
     """W = 1e300 x on [1, 3e10]: both forms overflow (3e310 > the largest double), so the bound is +inf, and
     the overflow inside the mean-value form raises no floating-point warning."""
