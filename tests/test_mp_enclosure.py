@@ -12,7 +12,7 @@ import mpmath
 import pytest
 import sympy as sp
 
-from uvsym.verify.mp_enclosure import enclose
+from uvsym.verify.mp_enclosure import _compare, _Undecided, enclose
 
 x, y = sp.symbols("x y", real=True)
 
@@ -124,3 +124,62 @@ def test_sign_of_an_interval_takes_every_sign_it_holds(wrap, expected):
     (straddle, enclosure) = enclose([x * x - 2, sp.sign(wrap(x * x - 2))], {x: 2 ** 0.5}, 10)
     assert straddle.a < 0 < straddle.b
     assert (_exact(enclosure.a), _exact(enclosure.b)) == expected
+
+
+@pytest.mark.parametrize("relation, expected", [(sp.Eq, 1), (sp.Ne, 0)])
+def test_equal_points_are_equal(relation, expected):
+    (enclosure,) = enclose([sp.Piecewise((1, relation(x, y)), (0, True))], {x: 0.5, y: 0.5}, 30)
+    assert _exact(enclosure.a) == _exact(enclosure.b) == expected
+
+
+def _interval(lower, upper):
+    return mpmath.iv.mpf([lower, upper])
+
+
+@pytest.mark.parametrize("relation", [sp.Eq, sp.Ne])
+@pytest.mark.parametrize("a, b", [((0, 1), (1, 2)), ((1, 2), (0, 1)), ((0, 1), (0, 1)), ((1, 1), (0, 2)),
+                                  ((0, 2), (1, 1))])
+def test_touching_or_overlapping_intervals_leave_equality_undecided(relation, a, b):
+    # [0, 1] and [1, 2] share the value 1; equal intervals [0, 1] need not hold equal values; a point inside an interval
+    with pytest.raises(_Undecided):
+        _compare(relation, _interval(*a), _interval(*b))
+
+
+@pytest.mark.parametrize("relation, a, b, expected", [
+    # disjoint intervals: decided either way
+    (sp.Lt, (0, 1), (2, 3), True), (sp.Lt, (2, 3), (0, 1), False), (sp.Ge, (2, 3), (0, 1), True),
+    (sp.Eq, (0, 1), (2, 3), False), (sp.Ne, (2, 3), (0, 1), True),
+    # touching at one value: a non-strict relation holds there, a strict one fails there
+    (sp.Le, (0, 1), (1, 2), True), (sp.Ge, (1, 2), (0, 1), True), (sp.Lt, (1, 2), (0, 1), False),
+    (sp.Gt, (0, 1), (1, 2), False),
+    # equal points
+    (sp.Le, (1, 1), (1, 1), True), (sp.Lt, (1, 1), (1, 1), False), (sp.Ge, (1, 1), (1, 1), True),
+    (sp.Gt, (1, 1), (1, 1), False)])
+def test_relations_decided_where_they_hold_or_fail_for_every_value(relation, a, b, expected):
+    assert _compare(relation, _interval(*a), _interval(*b)) is expected
+
+
+@pytest.mark.parametrize("relation, a, b", [
+    (sp.Lt, (0, 1), (1, 2)), (sp.Gt, (1, 2), (0, 1)),  # equal at 1: not <, elsewhere <
+    (sp.Le, (1, 2), (0, 1)), (sp.Ge, (0, 1), (1, 2)),  # equal at 1: <=, elsewhere not
+    (sp.Lt, (0, 2), (1, 3)), (sp.Le, (0, 2), (1, 3))])
+def test_relations_that_hold_for_some_values_only_are_undecided(relation, a, b):
+    with pytest.raises(_Undecided):
+        _compare(relation, _interval(*a), _interval(*b))
+
+
+@pytest.mark.parametrize("condition, expected", [
+    (sp.And(sp.Gt(x, 0), sp.Lt(y, -5)), 0), (sp.And(sp.Gt(x, 0), sp.Lt(y, 0)), 1),
+    (sp.Or(sp.Gt(x, 1), sp.Lt(y, 0)), 1), (sp.Or(sp.Gt(x, 1), sp.Lt(y, -5)), 0),
+    (sp.Not(sp.And(sp.Gt(x, 0), sp.Lt(y, 0))), 0), (sp.Not(sp.Or(sp.Gt(x, 1), sp.Lt(y, -5))), 1),
+    (sp.Not(sp.And(sp.Gt(x, 1), sp.Lt(y, 0))), 1)])
+def test_and_or_not_combine_decided_conditions(condition, expected):
+    # at x = 0.3, y = -2
+    (enclosure,) = enclose([sp.Piecewise((1, condition), (0, True))], {x: 0.3, y: -2.0}, 30)
+    assert _exact(enclosure.a) == _exact(enclosure.b) == expected
+
+
+def test_a_negative_base_takes_an_integer_power_and_refuses_a_fractional_one():
+    (cube, square) = enclose([x ** 3, x ** -2], {x: -2.0}, 30)
+    assert _exact(cube.a) == _exact(cube.b) == -8 and _exact(square.a) == _exact(square.b) == Fraction(1, 4)
+    assert enclose([x ** sp.Rational(1, 2)], {x: -2.0}, 30) is None

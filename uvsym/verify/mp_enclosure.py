@@ -87,7 +87,7 @@ def _evaluator(point: dict):
             exact = sp.Rational(e)  # a Float's binary value, exactly
             return iv.mpf(exact.p) / exact.q
         if e is sp.pi or e is sp.E:
-            return iv.pi + 0 if e is sp.pi else iv.e + 0
+            return iv.mpf(iv.pi if e is sp.pi else iv.e)  # the constant at the working precision
         args = [value(a) for a in e.args] if not isinstance(e, sp.Piecewise) else None
         if isinstance(e, sp.Add):
             return sum(args[1:], args[0])
@@ -97,14 +97,14 @@ def _evaluator(point: dict):
                 product = product * a
             return product
         if isinstance(e, sp.Pow):
-            return args[0] ** int(e.exp) if e.exp.is_Integer else args[0] ** args[1]
+            return args[0] ** args[1]  # an integer exponent (a point) is taken as mpmath's integer power
         if isinstance(e, sp.Abs):
             return abs(args[0])
         if e.func in FUNCTIONS:
             return FUNCTIONS[e.func](*args)
         if isinstance(e, (sp.Min, sp.Max)):
             pick = min if isinstance(e, sp.Min) else max
-            return _hull(pick((a.a for a in args), key=_Exact), pick((a.b for a in args), key=_Exact))
+            return _hull(pick(a.a for a in args), pick(a.b for a in args))  # points: always ordered
         if isinstance(e, sp.sign):
             (a,) = args
             return _hull(-1 if a.a < 0 else 0 if a.a == 0 else 1, 1 if a.b > 0 else 0 if a.b == 0 else -1)
@@ -115,16 +115,6 @@ def _evaluator(point: dict):
         raise _Undecided
 
     return value
-
-
-class _Exact:
-    """Sort key of an interval's endpoint (a point interval), ordered exactly: comparisons of points are decided."""
-
-    def __init__(self, endpoint):
-        self.endpoint = endpoint
-
-    def __lt__(self, other):
-        return bool(self.endpoint < other.endpoint)
 
 
 def enclose(expressions: list[sp.Expr], point: dict, digits: int) -> list | None:
