@@ -13,9 +13,10 @@ from fractions import Fraction
 import casadi as ca
 import numpy as np
 import pytest
+import sympy as sp
 
 from uvsym.verify import prove_identity
-from uvsym.verify.identity import _points
+from uvsym.verify.identity import _points, _rational_function
 
 SAMPLED = ("sampled: 30 points over {where}, mpmath 50 digits, each entry against the size of its terms, to the "
            "precision of the model's double constants (evidence, not a proof)")
@@ -182,6 +183,30 @@ def test_a_gap_exactly_at_twice_the_threshold_is_not_refuted():
     assert certificate.margin == -float(Fraction(gap) / Fraction(size))
 
 
+def test_a_gap_equal_to_the_threshold_rounded_up_is_not_refuted():
+    # a against b at a = y, b = w: the gap y - w = d = 3 2^-33 and the size y + w = s are exact in both the graph's and
+    # mpmath's intervals; s is the double whose exact product 2e-10 s lies in (d - ulp, d], so twice the threshold,
+    # rounded up, is d itself: a tie at every precision, not above it
+    d = 3 * 2.0 ** -33
+    near = float(Fraction(d) / Fraction(2e-10))
+    s = next(c for c in (near + i * np.spacing(near) for i in range(-3, 4))
+             if Fraction(np.nextafter(d, 0.0)) < Fraction(2e-10) * Fraction(c) <= Fraction(d))
+    y, w = (s + d) / 2, (s - d) / 2
+    assert Fraction(y) - Fraction(w) == Fraction(d) and Fraction(y) + Fraction(w) == Fraction(s)
+    a, b = ca.SX.sym("a"), ca.SX.sym("b")
+    certificate = prove_identity("tie", a, b, [a, b], "one point", box=([y, w], [y, w]), symbolic_seconds=1.0)
+    assert certificate.status == "inconclusive"
+    assert certificate.reason.endswith("is above 1e-10 at 50 digits, not confirmed by the interval re-check")
+
+
+def test_rational_functions_are_told_from_other_expressions():
+    x, y = sp.symbols("x y", real=True)
+    for rational in (x, sp.Rational(3, 7), x + y, 2 * x * y, x ** -3 / (y + 1) - sp.Rational(1, 3)):
+        assert _rational_function(rational), rational
+    for other in (sp.sin(x), sp.sqrt(x) + 1, x ** sp.Rational(1, 3) * y, sp.pi * x, sp.Float(0.5) * x, sp.Abs(x)):
+        assert not _rational_function(other), other
+
+
 def test_without_the_graphs_intervals_a_cancellation_beyond_a_hundred_digits_is_not_a_refutation():
     # (1 + 1e-13) / (D + 2) against 1/2 at x = 1e60: D is exactly 0 (relative difference 5e-14, below rounding), but
     # (x + 1)^2 takes 400 bits: D is -1 at 50 and at 100 digits (a relative difference of 1/3 at one evaluation);
@@ -227,6 +252,8 @@ def test_a_sampled_relative_difference_exactly_at_the_threshold_is_not_rechecked
     certificate = prove_identity("tie", lhs, rhs, [x, a, b, v, u], "one point", box=(point, point),
                                  symbolic_seconds=1.0)
     assert certificate.status == "inconclusive" and certificate.margin == -1e-10
+    assert certificate.reason == ("not shown zero symbolically; largest relative difference 1e-10 is above rounding "
+                                  "but below 1e-10")
 
 
 def test_a_size_of_the_terms_inflated_by_a_cancellation_beyond_a_hundred_digits_does_not_hide_a_refutation():
