@@ -99,7 +99,7 @@ def test_nonnegative_integer_power_is_defined_everywhere(exponent):
 def test_an_empty_batch_passes_through_a_power():
     x = ca.SX.sym("x", 2)
     result = IntervalFunction(ca.Function("f", [x], [x[0] ** x[1]]))(np.zeros((0, 2)), np.zeros((0, 2)))
-    assert result.lo.shape == (0, 1) and result.defined.shape == (0,)
+    assert result.lo.shape == result.hi.shape == (0, 1) and result.defined.shape == result.smooth.shape == (0,)
 
 
 def test_power_with_a_varying_exponent_is_refused_by_name():
