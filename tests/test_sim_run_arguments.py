@@ -3,6 +3,7 @@ the chunks between progress reports, input tables and initial states of other dt
 worked out by hand."""
 
 import math
+import time
 from fractions import Fraction
 from types import SimpleNamespace
 
@@ -113,3 +114,39 @@ def test_the_memory_needed_is_the_input_table_and_two_copies_of_the_logged_outpu
                                                        ["z"], ["z_disc", "u_cmd", "out"]))
     W, outputs = np.empty((10, 3)), np.empty((10, 5))
     assert run.memory_needed(10, loop) == W.nbytes + 2 * outputs.nbytes == 1040
+
+
+def test_a_divergence_is_named_with_its_signal_time_and_method():
+    # z' = z + a with a = inf at sample 1: z is finite at t = 0 and 0.5 s, inf from sample 2 (t = 1 s) on
+    W = np.zeros((4, 2))
+    W[1, 1] = math.inf
+    with pytest.raises(SimulationError) as caught:
+        run.run_closed_loop(_adder(), np.zeros(1), W, compiled=False)
+    assert str(caught.value).startswith("the loop diverged: z.c (inf) is non-finite from t = 1 s (fast); ")
+
+
+def test_the_guard_sees_the_times_and_rows_of_every_chunk():
+    seen = []
+    W = np.column_stack([0.5 * np.arange(4), np.ones(4)])
+    run.run_closed_loop(_adder(), np.zeros(1), W, compiled=False,
+                        guard=lambda t, rows: seen.append((list(t), rows[:, 0].tolist())))
+    assert [t for chunk in seen for t in chunk[0]] == [0.0, 0.5, 1.0]
+    assert [z for chunk in seen for z in chunk[1]] == [0.0, 1.0, 2.0]
+
+
+def test_the_result_has_empty_meta_and_the_timing_its_wall_clock_seconds():
+    before = time.perf_counter()
+    result, timing = run.run_closed_loop(_adder(), np.zeros(1), np.zeros((4, 2)), compiled=False)
+    elapsed = time.perf_counter() - before
+    assert result.meta == {} and isinstance(result.meta, dict)
+    assert set(timing) == {"wall_s", "build_s"} and 0.0 <= timing["wall_s"] <= elapsed
+
+
+@pytest.mark.parametrize("duration, dt", [(1e12, 1.0), (1e6, 1e-7), (2e12, 0.5)])
+def test_a_grid_of_a_trillion_samples_or_more_is_refused(duration, dt):
+    with pytest.raises(SimulationError, match=r"samples, more than 1e\+12 \(no machine holds them\)"):
+        run.grid(duration, dt)
+
+
+def test_a_grid_just_under_a_trillion_samples_is_counted():
+    assert run.grid(999_999_999_999.0, 1.0) == 999_999_999_999
