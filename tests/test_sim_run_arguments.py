@@ -150,3 +150,18 @@ def test_a_grid_of_a_trillion_samples_or_more_is_refused(duration, dt):
 
 def test_a_grid_just_under_a_trillion_samples_is_counted():
     assert run.grid(999_999_999_999.0, 1.0) == 999_999_999_999
+
+
+def test_the_refusal_of_a_huge_grid_gives_its_sample_count():
+    with pytest.raises(SimulationError) as caught:
+        run.grid(2e12, 0.5)
+    assert str(caught.value) == ("duration 2e+12 s at step 0.5 s is 4e+12 samples, more than 1e+12 (no machine holds "
+                                 "them); shorten the run or lengthen the step")
+
+
+def test_a_step_must_divide_the_duration_to_a_relative_1e_9():
+    # 1 us at a step 0.1 ns too long: one sample, 1e-10 s short of the step, far above 1e-9 of the duration (1e-15 s)
+    with pytest.raises(SimulationError, match=r"^step 1.0001e-06 s does not divide duration 1e-06 s$"):
+        run.grid(1e-6, 1.0001e-6)
+    # the smallest double divided by itself: no gap at all, where 1e-9 of the duration rounds to 0
+    assert run.grid(5e-324, 5e-324) == 1
