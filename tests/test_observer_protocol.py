@@ -257,3 +257,30 @@ def test_initial_state_refuses_an_init_of_the_wrong_size_or_not_finite(init, siz
     with pytest.raises(ObserverError) as refused:
         _held_sum_observer(init).initial_state([1.0, 2.0], [3.0])
     assert str(refused.value) == f"avg2: init gave {size} entries (finite: {finite}), expected 2 finite"
+
+
+def _builder_common():
+    return dict(state=signals(("a", "-")), reads_y=signals(("b", "-")), reads_u=signals(),
+                publishes=signals(("a_hat", "-")), dt=0.1)
+
+
+@pytest.mark.parametrize("step, message", [
+    (lambda s, y, u, p: [s, s], "luen: step must return (s_next, out)"),  # a list, not a tuple
+    (lambda s, y, u, p: (s,), "luen: step must return (s_next, out)"),
+    (lambda s, y, u, p: (s, s, s), "luen: step must return (s_next, out)"),
+    (lambda s, y, u, p: (s, "a"), "luen: step: expected a CasADi expression or a list of them, got str"),
+    (lambda s, y, u, p: (ca.vertcat(s, s), s), "luen: step gives s_next with 2 entries, expected 1"),
+    (lambda s, y, u, p: (s, s + ca.SX.sym("k")), "luen: step uses symbols other than s, y, u, p: ['k']")])
+def test_the_observer_builder_names_what_its_step_returned_wrong(step, message):
+    with pytest.raises(ObserverError) as caught:
+        observer("luen", step=step, **_builder_common())
+    assert str(caught.value) == message
+
+
+def test_the_observer_builder_names_a_bad_observer_name_and_defaults_to_no_parameters():
+    with pytest.raises(ObserverError) as caught:
+        observer("my-observer", step=lambda s, y, u, p: (s, s), **_builder_common())
+    assert str(caught.value) == ("observer name 'my-observer' must start with a letter and hold only letters, digits "
+                                 "and single underscores (it names C functions)")
+    built = observer("luen", step=lambda s, y, u, p: (s, s), **_builder_common())
+    assert built.params.size == 0 and built.params.group == "parameter" and built.p0.shape == (0,)
