@@ -284,3 +284,11 @@ def test_the_observer_builder_names_a_bad_observer_name_and_defaults_to_no_param
                                  "and single underscores (it names C functions)")
     built = observer("luen", step=lambda s, y, u, p: (s, s), **_builder_common())
     assert built.params.size == 0 and built.params.group == "parameter" and built.p0.shape == (0,)
+
+
+def test_the_observer_builder_names_a_nan_constant_and_the_cure():
+    # math.nan in the step (what float(symbol) arithmetic through numpy or math would leave behind)
+    with pytest.raises(ObserverError) as caught:
+        observer("luen", step=lambda s, y, u, p: (s + float("nan"), s), **_builder_common())
+    assert str(caught.value) == ("luen: the step holds a NaN constant: a math or numpy function applied to a CasADi "
+                                 "symbol gives NaN; use casadi's own (ca.sin, ca.exp, ...)")
