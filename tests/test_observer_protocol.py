@@ -292,3 +292,35 @@ def test_the_observer_builder_names_a_nan_constant_and_the_cure():
         observer("luen", step=lambda s, y, u, p: (s + float("nan"), s), **_builder_common())
     assert str(caught.value) == ("luen: the step holds a NaN constant: a math or numpy function applied to a CasADi "
                                  "symbol gives NaN; use casadi's own (ca.sin, ca.exp, ...)")
+
+
+def _step_function(inputs=("s", "y", "u", "p"), outputs=("s_next", "out")):
+    """A step of one state, one measurement, no input or parameter: (s, y) -> (s, s), with the given names."""
+    s, y, u, p = ca.SX.sym("s"), ca.SX.sym("y"), ca.SX.sym("u", 0), ca.SX.sym("p", 0)
+    return ca.Function("step", [s, y, u, p], [s, s], list(inputs), list(outputs))
+
+
+def _direct(name="luen", step=None, state=("a",), reads_y=("b",)):
+    return Observer(name, _step_function() if step is None else step, Signals(state, ("-",) * len(state)),
+                    Signals(reads_y, ("-",) * len(reads_y)), Signals(), Signals(), Signals(("o",), ("-",)),
+                    np.zeros(0), 0.1)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (dict(name="bad-name"), "observer name 'bad-name' must start with a letter and hold only letters, digits and "
+                            "single underscores (it names C functions)"),
+    (dict(reads_y=("a",)), "luen: names ['a'] stand in more than one of state, reads_y, reads_u, params; each signal "
+                           "needs its own name"),
+    (dict(step="not a function"), "luen: step must be a casadi.Function, got str"),
+    (dict(step=_step_function(outputs=("s_next", "y_out"))),
+     "luen: step must map (s, y, u, p) -> (s_next, out), got (s, y, u, p) -> (s_next, y_out)"),
+    (dict(step=_step_function(inputs=("s", "y", "u", "q"))),
+     "luen: step must map (s, y, u, p) -> (s_next, out), got (s, y, u, q) -> (s_next, out)")])
+def test_an_observer_built_directly_names_what_is_wrong(arguments, message):
+    with pytest.raises(ObserverError) as caught:
+        _direct(**arguments)
+    assert str(caught.value) == message
+
+
+def test_an_observer_built_directly_with_distinct_names_is_accepted():
+    assert _direct().name == "luen"
