@@ -6,7 +6,7 @@ import pytest
 from scipy.linalg import expm
 
 import uvsym
-from uvsym.errors import ModelError, ObserverError
+from uvsym.errors import ArgumentError, ModelError, ObserverError
 from uvsym.observers.actuator import actuator_observer
 from uvsym.observers.base import Observer, observer
 from uvsym.observers.discrete import actuator_fault_observer, gain_units, sampled_observer
@@ -324,3 +324,46 @@ def test_an_observer_built_directly_names_what_is_wrong(arguments, message):
 
 def test_an_observer_built_directly_with_distinct_names_is_accepted():
     assert _direct().name == "luen"
+
+
+def _full_observer(name="luen", dt=0.1, p0=(2,), publishes=("o",)):
+    """s' = s + k y + c / y, out = log(s): state a, measurement b, input c, parameter k, output o."""
+    s, y, u, p = ca.SX.sym("s"), ca.SX.sym("y"), ca.SX.sym("u"), ca.SX.sym("p")
+    step = ca.Function("step", [s, y, u, p], [s + p * y + u / y, ca.log(s)], ["s", "y", "u", "p"], ["s_next", "out"])
+    return Observer(name, step, Signals(("a",), ("m",)), Signals(("b",), ("m",)), Signals(("c",), ("N",)),
+                    Signals(("k",), ("-",)), Signals(publishes, ("-",) * len(publishes)), p0, dt)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ((float("nan"), 1.0, 0.0, 2.0), "luen.step: argument s entry a is nan; every entry must be finite"),
+    ((1.0, float("nan"), 0.0, 2.0), "luen.step: argument y entry b is nan; every entry must be finite"),
+    ((1.0, 1.0, float("inf"), 2.0), "luen.step: argument u entry c is inf; every entry must be finite"),
+    ((1.0, 1.0, 0.0, float("-inf")), "luen.step: argument p entry k is -inf; every entry must be finite"),
+    ((1.0, 0.0, 1.0, 2.0), "luen.step: output s_next entry a is inf at finite arguments"),
+    ((0.0, 1.0, 0.0, 2.0), "luen.step: output out entry o is -inf at finite arguments")])
+def test_an_observers_step_names_each_non_finite_entry_by_its_signal(arguments, message):
+    with pytest.raises(ArgumentError) as caught:
+        _full_observer().step(*arguments)
+    assert str(caught.value).startswith(message)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (dict(dt=float("inf")), "luen: sample period dt must be positive and finite (s), got inf"),
+    (dict(dt=0.0), "luen: sample period dt must be positive and finite (s), got 0.0"),
+    (dict(publishes=("o", "q")), "luen: step output out has 1 entries but 2 signals are named (o, q)"),
+    (dict(p0=(1.0, 2.0)), "luen: parameters p0")])
+def test_an_observer_names_a_bad_period_output_count_or_parameter_vector(arguments, message):
+    with pytest.raises(ObserverError) as caught:
+        _full_observer(**arguments)
+    assert str(caught.value).startswith(message)
+
+
+def test_an_observer_stores_its_parameters_as_floats_and_takes_capitals_in_its_name():
+    built = _full_observer(name="Luen_2")
+    assert isinstance(built.p0, np.ndarray) and built.p0.dtype == float and built.p0.tolist() == [2.0]
+
+
+def test_an_input_count_mismatch_lists_the_named_signals():
+    with pytest.raises(ObserverError) as caught:
+        _direct(state=("a", "z"))
+    assert str(caught.value) == "luen: step input s has 1 entries but 2 signal signals are named (a, z)"
