@@ -219,38 +219,31 @@ def test_without_the_graphs_intervals_a_cancellation_beyond_a_hundred_digits_is_
     assert certificate.reason.endswith("is above 1e-10 at 50 digits, not confirmed by the interval re-check")
 
 
-def test_without_intervals_a_relative_difference_exactly_at_the_threshold_is_not_confirmed():
-    # x + t / (D + 2) + w1 + w2 + tan(u) against t / 2 + w1 + w2 + tan(u), t = 1/4, at x = 1e-10 (the double), u = 0,
-    # w1 + w2 = (3/4 - x) / 2 exactly (two doubles): at 100 digits (D = 0) the difference is x and the size of the
-    # terms x + 2 (w1 + w2) + 3 t / 2 - t / 2 = 1, a relative difference of exactly 1e-10, not above it; at 50 digits
-    # (D = -1) it is large
-    rest = Fraction(3, 4) - Fraction(1e-10)
+def _threshold_tie(rest: Fraction, constant: float):
+    """x + 1/4 / (D + 2) + w1 + w2 + tan(u) against constant + w1 + w2 + tan(u) at x = 1e-10 (the double), u = 0,
+    v = 1e30 in D, with w1 + w2 = rest / 2 exactly (two doubles)."""
     w1 = float(rest / 2)
     w2 = float(rest / 2 - Fraction(w1))
     assert Fraction(w1) + Fraction(w2) == rest / 2
     x, a, b, v, u = (ca.SX.sym(name) for name in ("x", "a", "b", "v", "u"))
     lhs = x + 0.25 / (_cancelling(v) + 2) + a + b + ca.tan(u)
-    rhs = 0.125 + a + b + ca.tan(u)
+    rhs = constant + a + b + ca.tan(u)
     point = [1e-10, w1, w2, 1e30, 0.0]
-    certificate = prove_identity("tie", lhs, rhs, [x, a, b, v, u], "one point", box=(point, point),
-                                 symbolic_seconds=1.0)
+    return prove_identity("tie", lhs, rhs, [x, a, b, v, u], "one point", box=(point, point), symbolic_seconds=1.0)
+
+
+def test_without_intervals_a_relative_difference_exactly_at_the_threshold_is_not_confirmed():
+    # t = 1/4 against t / 2, w1 + w2 = (3/4 - x) / 2: at 100 digits (D = 0) the difference is x and the size of the
+    # terms x + 2 (w1 + w2) + 3 t / 2 - t / 2 = 1, a relative difference of exactly 1e-10, not above it; at 50 digits
+    # (D = -1) it is large
+    certificate = _threshold_tie(Fraction(3, 4) - Fraction(1e-10), 0.125)
     assert certificate.status == "inconclusive"
 
 
 def test_a_sampled_relative_difference_exactly_at_the_threshold_is_not_rechecked():
-    # x + t / (D + 2) + w1 + w2 + tan(u) against t + w1 + w2 + tan(u), t = 1/4, at x = 1e-10 (the double), u = 0,
-    # w1 + w2 = (1/2 - x) / 2 exactly: at 50 digits (D = -1) the difference is x and the size of the terms
+    # t = 1/4 against t, w1 + w2 = (1/2 - x) / 2: at 50 digits (D = -1) the difference is x and the size of the terms
     # x + t + 2 (w1 + w2) + t = 1, a relative difference of exactly 1e-10, not above it (at 100 digits it is large)
-    rest = Fraction(1, 2) - Fraction(1e-10)
-    w1 = float(rest / 2)
-    w2 = float(rest / 2 - Fraction(w1))
-    assert Fraction(w1) + Fraction(w2) == rest / 2
-    x, a, b, v, u = (ca.SX.sym(name) for name in ("x", "a", "b", "v", "u"))
-    lhs = x + 0.25 / (_cancelling(v) + 2) + a + b + ca.tan(u)
-    rhs = 0.25 + a + b + ca.tan(u)
-    point = [1e-10, w1, w2, 1e30, 0.0]
-    certificate = prove_identity("tie", lhs, rhs, [x, a, b, v, u], "one point", box=(point, point),
-                                 symbolic_seconds=1.0)
+    certificate = _threshold_tie(Fraction(1, 2) - Fraction(1e-10), 0.25)
     assert certificate.status == "inconclusive" and certificate.margin == -1e-10
     assert certificate.reason == ("not shown zero symbolically; largest relative difference 1e-10 is above rounding "
                                   "but below 1e-10")
