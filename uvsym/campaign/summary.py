@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-from uvsym.report.figures import plt, save_svg
 from uvsym.report.html import write_html
 from uvsym.report.markdown import markdown_table, write_json
 
@@ -86,6 +85,8 @@ def _label(value) -> str:
 
 
 def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
+    from uvsym.report.figures import plt, save_svg  # here: a campaign's worker processes never draw
+
     labels_true = list(summary["confusion"])
     labels_isolated = sorted({k for cell in summary["confusion"].values() for k in cell})
     fig, ax = plt.subplots(figsize=(5.5, 4.5))

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-import scipy.signal
 
 from uvsym.errors import ObserverError
 from uvsym.models.model import Model
@@ -169,12 +168,14 @@ class RegressorBank:
     def _through_filter(self, series: np.ndarray, previous: np.ndarray, state: np.ndarray):
         """(filtered, state): ``series`` (k, ..., n) through the observer's filter, the trapezoid's input
         averaged with ``previous`` (..., n) before the first row, from the per-mode ``state`` (1, ..., n)."""
+        from scipy.signal import lfilter  # here: importing scipy.signal takes most of a second
+
         averaged = (np.concatenate([previous[None], series[:-1]]) + series) / 2
         modal = averaged @ self.V_inv.T
         out, state = np.empty_like(modal), state.copy()
         for j in range(self.n):
-            out[..., j], state[..., j] = scipy.signal.lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[..., j],
-                                                              axis=0, zi=state[..., j])
+            out[..., j], state[..., j] = lfilter([self.gamma[j]], [1.0, -self.phi[j]], modal[..., j], axis=0,
+                                               zi=state[..., j])
         return out @ self.V.T, state
 
     def _mapped(self, function, k: int):

@@ -1,46 +1,22 @@
-"""Fault-diagnosis observers, isolation, identification and fault-tolerant correction."""
+"""Fault-diagnosis observers, isolation, identification and fault-tolerant correction.
 
-from uvsym.observers.actuator import (
-    FORMS,
-    KINDS,
-    ActuatorObserver,
-    actuator_observer,
-    bias_observer,
-    constant_observer,
-    init_state,
-    proportional_observer,
-)
-from uvsym.observers.ekf import ekf, extended_filter
-from uvsym.observers.hybrid import FaultEstimator, decouple, hybrid_observer, with_sensor_fault_states
-from uvsym.observers.lms import lms_monitor, lms_step
-from uvsym.observers.lms_supervisor import SubstitutionSupervisor
-from uvsym.observers.mmae import mmae_bank
-from uvsym.observers.uio import UIOMatrices, uio_conditions, uio_matrices, uio_observer
-from uvsym.observers.ukf import ukf, unscented_filter
+The names below are imported on first use (:mod:`uvsym.lazy`): ``import uvsym.observers.base``, as the
+simulator and every campaign worker do, does not pay for scipy.signal and sympy, which only the UIO and
+hybrid observers need.
+"""
 
-__all__ = [
-    "FORMS",
-    "KINDS",
-    "ActuatorObserver",
-    "actuator_observer",
-    "bias_observer",
-    "constant_observer",
-    "init_state",
-    "proportional_observer",
-    "UIOMatrices",
-    "uio_conditions",
-    "uio_matrices",
-    "uio_observer",
-    "ekf",
-    "extended_filter",
-    "FaultEstimator",
-    "decouple",
-    "hybrid_observer",
-    "with_sensor_fault_states",
-    "mmae_bank",
-    "ukf",
-    "unscented_filter",
-    "lms_monitor",
-    "lms_step",
-    "SubstitutionSupervisor",
-]
+from uvsym.lazy import lazy_exports
+
+_EXPORTS = {  # name -> the submodule that defines it
+    **dict.fromkeys(["FORMS", "KINDS", "ActuatorObserver", "actuator_observer", "bias_observer", "constant_observer",
+                     "init_state", "proportional_observer"], "actuator"),
+    **dict.fromkeys(["UIOMatrices", "uio_conditions", "uio_matrices", "uio_observer"], "uio"),
+    **dict.fromkeys(["ekf", "extended_filter"], "ekf"),
+    **dict.fromkeys(["FaultEstimator", "decouple", "hybrid_observer", "with_sensor_fault_states"], "hybrid"),
+    "mmae_bank": "mmae",
+    **dict.fromkeys(["ukf", "unscented_filter"], "ukf"),
+    **dict.fromkeys(["lms_monitor", "lms_step"], "lms"),
+    "SubstitutionSupervisor": "lms_supervisor",
+}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

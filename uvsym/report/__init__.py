@@ -1,6 +1,10 @@
-"""Report building blocks: Markdown tables and matrices, deterministic JSON and SVG figures."""
+"""Report building blocks: Markdown tables and matrices, deterministic JSON and SVG figures.
 
-from uvsym.report.figures import save_svg
-from uvsym.report.markdown import latex_matrix, markdown_table, write_json
+The names are imported on first use (:mod:`uvsym.lazy`): writing a table or JSON does not import matplotlib.
+"""
 
-__all__ = ["latex_matrix", "markdown_table", "save_svg", "write_json"]
+from uvsym.lazy import lazy_exports
+
+_EXPORTS = {"latex_matrix": "markdown", "markdown_table": "markdown", "write_json": "markdown", "save_svg": "figures"}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

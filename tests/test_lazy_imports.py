@@ -1,0 +1,46 @@
+"""Packages import their names on first use: a campaign worker and the simulator start without scipy.signal,
+sympy or matplotlib, and every exported name still resolves to the object its submodule defines."""
+
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+
+import pytest
+
+from uvsym.lazy import lazy_exports
+
+HEAVY = ("scipy.signal", "sympy", "matplotlib")
+
+
+def test_a_campaign_worker_and_the_simulator_start_without_the_heavy_libraries():
+    code = ("import sys, uvsym.campaign.worker, uvsym.sim.simulation, uvsym.observers.base, uvsym.report; "
+            f"print(' '.join(m for m in {HEAVY!r} if m in sys.modules))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.split() == []
+
+
+@pytest.mark.parametrize("package", ["uvsym.observers", "uvsym.report"])
+def test_every_exported_name_is_its_submodules_object_and_dir_lists_it(package):
+    module = importlib.import_module(package)
+    for name, submodule in module._EXPORTS.items():
+        assert getattr(module, name) is getattr(importlib.import_module(f"{package}.{submodule}"), name)
+    assert set(module.__all__) <= set(dir(module))
+
+
+def test_an_unknown_name_raises_attribute_error_and_a_known_one_is_kept_after_its_first_use(monkeypatch):
+    import types
+
+    package = types.ModuleType("fake_package")
+    monkeypatch.setitem(sys.modules, "fake_package", package)
+    monkeypatch.setitem(sys.modules, "fake_package.numbers", types.SimpleNamespace(answer=42))
+    package.__getattr__, package.__dir__ = lazy_exports("fake_package", {"answer": "numbers"})
+    with pytest.raises(AttributeError, match="module 'fake_package' has no attribute 'question'"):
+        package.question  # noqa: B018
+    assert "answer" not in vars(package) and "answer" in package.__dir__()
+    assert package.answer == 42 and vars(package)["answer"] == 42
+    from fake_package import answer
+
+    assert answer == 42
