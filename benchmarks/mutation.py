@@ -279,6 +279,9 @@ def main(argv: list[str] | None = None) -> int:
     else:
         modules = available if not args.modules else [m for m in available if any(
             fnmatch.fnmatch(m, p) or m == p for p in args.modules)]
+    if not modules and args.again:
+        parser.error(f"--modules matches none of the modules whose mutants {args.again} holds (its last run mutated "
+                     f"{', '.join(kept)}): run the module afresh with --keep")
     if not modules:
         parser.error(f"--modules matches none of the configured modules: {', '.join(available)}")
     started, clock = datetime.now(timezone.utc).isoformat(timespec="seconds"), time.perf_counter()

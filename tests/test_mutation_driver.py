@@ -101,3 +101,26 @@ def test_again_brings_current_sources_and_drops_a_mutated_module_that_changed(tm
     assert (tmp_path / "mutants" / module).read_text() == "# mutmut's mutants\n"
     for folder in (tmp_path, tmp_path / "mutants"):
         assert (folder / other).read_bytes() == (ROOT / other).read_bytes()  # now as it is, unmutated
+
+
+def test_again_names_the_modules_a_kept_folder_holds_when_the_one_asked_for_is_not_among_them(tmp_path, capsys):
+    (tmp_path / "pyproject.toml").write_text('[tool.mutmut]\nonly_mutate = ["uvsym/faults.py"]\n')
+    with pytest.raises(SystemExit):
+        mutation.main(["--again", str(tmp_path), "--modules", "uvsym/observers/actuator.py"])
+    assert (f"matches none of the modules whose mutants {tmp_path} holds (its last run mutated uvsym/faults.py): run "
+            "the module afresh with --keep") in capsys.readouterr().err
+
+
+def test_the_readme_quotes_the_committed_mutation_results():
+    import re
+
+    results = json.loads((ROOT / "benchmarks" / "results" / "mutation.json").read_text())
+    quoted = re.search(r"as committed: (\d+) modules, ([\d,]+) mutants, ([\d,]+) killed, ([\d,]+) listed as "
+                       r"equivalent, (\w+) surviving", " ".join((ROOT / "README.md").read_text().split()))
+    assert quoted, "README.md no longer quotes the committed mutation results"
+    modules, mutants, killed, equivalent = (int(g.replace(",", "")) for g in quoted.groups()[:4])
+    records = results["modules"].values()
+    assert (modules, mutants) == (len(results["modules"]), sum(r["total"] for r in records))
+    assert (killed, equivalent) == (sum(r["killed"] for r in records), sum(r["equivalent"] for r in records))
+    surviving = sum(r["survived"] for r in records)
+    assert quoted.group(5) == ("none" if surviving == 0 else str(surviving))
