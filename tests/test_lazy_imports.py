@@ -30,6 +30,17 @@ def test_every_exported_name_is_its_submodules_object_and_dir_lists_it(package):
     assert set(module.__all__) <= set(dir(module))
 
 
+def test_a_function_named_as_its_submodule_stays_the_function_after_the_submodule_is_imported():
+    import types
+
+    for name in ("ekf", "ukf"):
+        submodule = importlib.import_module(f"uvsym.observers.{name}")
+        function = getattr(importlib.import_module("uvsym.observers"), name)
+        assert not isinstance(function, types.ModuleType) and function is getattr(submodule, name)
+    with pytest.raises(ValueError, match="fake: ekf named as its submodule: import it eagerly instead"):
+        lazy_exports("fake", {"ekf": "ekf", "other": "ekf"})
+
+
 def test_an_unknown_name_raises_attribute_error_and_a_known_one_is_kept_after_its_first_use(monkeypatch):
     import types
 
