@@ -9,7 +9,7 @@ sys.path.insert(0, str(ROOT))
 project = "uvsym"
 author = "The uvsym developers"
 copyright = "2026, The uvsym developers"  # noqa: A001 (Sphinx's name)
-extensions = ["sphinx.ext.autodoc", "numpydoc", "myst_parser"]
+extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "myst_parser"]  # napoleon reads the NumPy-style sections
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 master_doc = "index"
 exclude_patterns = ["_build"]
@@ -17,7 +17,5 @@ myst_enable_extensions = ["dollarmath"]
 myst_heading_anchors = 3
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
-numpydoc_show_class_members = False
-numpydoc_class_members_toctree = False
-numpydoc_validation_checks: set[str] = set()
+napoleon_google_docstring = False
 html_theme = "alabaster"
