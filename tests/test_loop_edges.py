@@ -226,3 +226,20 @@ def test_a_zero_duration_or_step_is_refused_by_name(duration, dt):
     with pytest.raises(SimulationError, match=rf"^duration and step must be positive and finite, got {duration} s "
                                               rf"and {dt} s$"):
         run.grid(duration, dt)
+
+
+def test_each_integrator_is_built_with_its_documented_defaults_under_the_runs_own_options():
+    """cvodes and idas at tolerances 1e-12, collocation with one element per sample, rk with CasADi's own: the
+    message of a refused option shows the options the integrator was built with; a run's option replaces a default."""
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    expected = {"cvodes": "{'abstol': 1e-12, 'reltol': 1e-12, 'bogus': 1}",
+                "idas": "{'abstol': 1e-12, 'reltol': 1e-12, 'bogus': 1}",
+                "collocation": "{'number_of_finite_elements': 1, 'bogus': 1}", "rk": "{'bogus': 1}"}
+    for method, shown in expected.items():
+        with pytest.raises(SimulationError) as error:
+            simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method=method, options={"bogus": 1})
+        assert str(error.value).startswith(f"cannot build the {method} integrator with options {shown}: "), method
+    with pytest.raises(SimulationError) as error:
+        simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method="collocation",
+                        options={"number_of_finite_elements": 3, "bogus": 1})
+    assert "with options {'number_of_finite_elements': 3, 'bogus': 1}: " in str(error.value)
