@@ -142,9 +142,9 @@ def test_a_non_finite_argument_is_named_by_the_model_function_argument_and_entry
 
 
 def test_a_non_finite_output_is_named_by_its_entry_label():
-    """Finite arguments so large that the products overflow: the first non-finite entry of x_dot and e_dot is named
-    (X, the surge force, for these arguments). (f_hat = x - R does not overflow alone: x_dot, checked first, holds
-    L M^-1 G (x - R).)"""
+    """Finite arguments so large that the products overflow: the first non-finite entry is named (X, the surge
+    force, for these arguments). Called by position the outputs are checked in order (x_dot first); called by
+    name CasADi returns them by name (f_hat first), so f_hat's own overflow is named too."""
     from uvsym.errors import ArgumentError
     from uvsym.observers.actuator import actuator_observer
 
@@ -152,6 +152,9 @@ def test_a_non_finite_output_is_named_by_its_entry_label():
     big, ones = np.full(3, 1e200), np.ones(3)
     with pytest.raises(ArgumentError, match=r"^otter3dof\.bias_observer: output x_dot entry X is -?inf at finite"):
         obs.function(big, ones, ones, ones, big)
+    x = np.array([1.79e308, 1.0, 1.0])  # x - R overflows in the first entry, where R = -K M^-1 nu
+    with pytest.raises(ArgumentError, match=r"^otter3dof\.bias_observer: output f_hat entry X is inf at finite"):
+        obs.function(x=x, eta=ones, nu=ones, tau_d=ones, K=np.array([1e308, 1.0, 1.0]))
     with pytest.raises(ArgumentError, match=r"^otter3dof\.e_dot: output e_dot entry X is -?inf at finite"):
         obs.error_dynamics(big, ones, ones, ones, ones, ones, big)
 

@@ -47,12 +47,17 @@ def test_every_example_runs(example, tmp_path, monkeypatch, capsys):
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:The mapping interface for autodoc options")  # Sphinx's own
-def test_sphinx_builds_the_documentation_without_a_warning(tmp_path, capsys):  # napoleon, on Sphinx 9
+def test_sphinx_builds_the_documentation_without_a_warning(tmp_path, capsys, monkeypatch):  # napoleon, Sphinx 9
     pytest.importorskip("sphinx", reason="sphinx is in the test extra: pip install -e '.[test]'")
     pytest.importorskip("myst_parser", reason="myst-parser is in the test extra")
+    import logging
+
     from sphinx.cmd.build import build_main
 
-    # in this process: autodoc finds uvsym imported already (a separate process spends most of its time importing)
+    # in this process: autodoc finds uvsym imported already (a separate process spends most of its time importing);
+    # what the build changes here is put back: docs/conf.py's sys.path entry, the handlers of Sphinx's logger
+    monkeypatch.setattr(sys, "path", list(sys.path))
+    monkeypatch.setattr(logging.getLogger("sphinx"), "handlers", list(logging.getLogger("sphinx").handlers))
     status = build_main(["-W", "--keep-going", "-q", "-b", "html", str(ROOT / "docs"), str(tmp_path / "html")])
     assert status == 0, capsys.readouterr().err[-6000:]
     page = (tmp_path / "html" / "api.html").read_text()

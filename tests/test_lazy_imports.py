@@ -14,12 +14,17 @@ from uvsym.lazy import lazy_exports
 HEAVY = ("scipy.signal", "sympy", "matplotlib")
 
 
-def test_a_campaign_worker_and_the_simulator_start_without_the_heavy_libraries():
-    code = ("import sys, uvsym.campaign.worker, uvsym.sim.simulation, uvsym.observers.base, uvsym.report; "
-            f"print(' '.join(m for m in {HEAVY!r} if m in sys.modules))")
+def test_a_campaign_worker_and_the_simulator_start_without_the_heavy_libraries_and_every_name_resolves():
+    """In a fresh interpreter (the order of first imports is a new user's): then every exported name is the
+    object it names, not a module of the same name."""
+    code = ("import sys, types, uvsym.campaign.worker, uvsym.sim.simulation, uvsym.observers.base, uvsym.report\n"
+            f"print(' '.join(m for m in {HEAVY!r} if m in sys.modules))\n"
+            "import uvsym.observers as o, uvsym.report as r\n"
+            "print(' '.join(f'{p.__name__}.{n}' for p in (o, r) for n in p.__all__ "
+            "if isinstance(getattr(p, n), types.ModuleType)))")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-3000:]
-    assert run.stdout.split() == []
+    assert run.stdout.splitlines() == ["", ""]
 
 
 @pytest.mark.parametrize("package", ["uvsym.observers", "uvsym.report"])
@@ -37,14 +42,15 @@ def test_a_function_named_as_its_submodule_stays_the_function_after_the_submodul
         submodule = importlib.import_module(f"uvsym.observers.{name}")
         function = getattr(importlib.import_module("uvsym.observers"), name)
         assert not isinstance(function, types.ModuleType) and function is getattr(submodule, name)
-    with pytest.raises(ValueError, match="fake: ekf named as its submodule: import it eagerly instead"):
-        lazy_exports("fake", {"ekf": "ekf", "other": "ekf"})
+    with pytest.raises(ValueError, match="uvsym.observers: ekf, lms named as a submodule: import it eagerly instead"):
+        lazy_exports("uvsym.observers", {"ekf": "ekf", "lms": "mmae", "other": "ekf"})  # its own and a sibling
 
 
 def test_an_unknown_name_raises_attribute_error_and_a_known_one_is_kept_after_its_first_use(monkeypatch):
     import types
 
     package = types.ModuleType("fake_package")
+    package.__path__ = []  # a package without submodules on disk
     monkeypatch.setitem(sys.modules, "fake_package", package)
     monkeypatch.setitem(sys.modules, "fake_package.numbers", types.SimpleNamespace(answer=42))
     package.__getattr__, package.__dir__ = lazy_exports("fake_package", {"answer": "numbers"})

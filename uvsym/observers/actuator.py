@@ -50,8 +50,9 @@ class ActuatorObserver:
 
     function(x, eta, nu, tau_d, K) -> (x_dot, f_hat); R(nu, tau_d, K) -> R; L(nu, tau_d, K) -> dR/dnu;
     error_matrix(tau_d, K) -> A with ``e' = A e`` for constant ``tau_d``;
-    error_dynamics(e, nu, nu_dot, tau_d, tau_d_dot, K) -> e' exactly, including the term
-    ``-(dR/dtau_d) tau_d'`` that the paper's proof drops when ``tau_d`` varies.
+    error_dynamics(e, f, eta, nu, tau_d, tau_d_dot, K) -> e' exactly for a constant fault f on the plant
+    ``M nu' = G f + b - h``, including the term ``+(dR/dtau_d) tau_d'`` that the paper's proof drops when
+    ``tau_d`` varies.
     """
 
     kind: str

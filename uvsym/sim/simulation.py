@@ -57,8 +57,8 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
         each reads measured states and ``tau_d.<force>`` by name and starts from ``init``.
     supervisor : discrete logic run every ``supervisor.period`` s that may correct the commands.
     method : ``fast`` (compiled fixed-step RK4 with ``substeps`` per sample) or a CasADi
-        integrator plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it
-        (defaults: :data:`uvsym.sim.run.DEFAULT_OPTIONS`, tolerances 1e-12, one collocation element).
+        integrator plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it,
+        over the defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
     seed : seed of the standard normal draws behind sensor noise faults.
 
     Returns

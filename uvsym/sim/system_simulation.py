@@ -44,7 +44,8 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     ----------
     x0 : (n_x,) initial plant state (array or ``{name: value}``), in the states' units.
     method : ``fast`` (compiled fixed-step RK4, ``substeps`` per sample) or a CasADi integrator
-        plugin (``cvodes``, ``idas``, ``rk``, ``collocation``); ``options`` go to it.
+        plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it, over the
+        defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
     d : plant disturbances, constant (n_d,) or one row per sample (N + 1, n_d); default 0.
     p : plant parameters (default ``plant.p0``); substitutions: channel -> substitute signal,
         switched by the supervisor's ``Substitution`` decisions (all off at the start).
