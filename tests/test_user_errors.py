@@ -152,8 +152,15 @@ def test_model_functions_name_the_argument_and_agree_with_the_raw_function():
         model.tau(x[:6], x[6:], [], 0.0, 0.0)
     with pytest.raises(ArgumentError, match="argument eta has 6 entries \\(shape \\(2, 3\\)\\)"):
         model.B(np.ones((2, 3)), x[6:], u, 0.0, 0.0)
-    with pytest.raises(ArgumentError, match="argument u must be numbers"):
+    with pytest.raises(ArgumentError, match="argument u must be real numbers or a CasADi expression, got str"):
         model.f(x, "thrust", [0.0, 0.0])
+    with pytest.raises(ArgumentError, match="argument x must be real numbers or a CasADi expression, got NoneType"):
+        model.f(None, u, [0.0, 0.0])  # not read as NaN
+    with pytest.raises(ArgumentError, match="argument p must be real numbers or a CasADi expression, got ndarray"):
+        model.f(x, u, np.array([0.2, 0.3]) + 1j)  # not cut to its real part
+    with pytest.raises(ArgumentError, match=r"output x_dot entry \w+ is -?(inf|nan) at finite arguments .*outside "
+                                            r"the equations' domain or overflows double precision"):
+        model.f(np.r_[x[:6], 1e200, x[7:]], u, [0.0, 0.0])  # quadratic damping of a 1e200 m/s surge
     pitched_up = x.copy()
     pitched_up[4] = math.pi / 2  # J(eta) is singular: the raw Function gives ~1e15 here
     assert np.abs(np.asarray(model.f.raw(pitched_up, u, [0.0, 0.0]))).max() > 1e12

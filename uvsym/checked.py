@@ -81,8 +81,8 @@ class CheckedFunction(ca.Function):
         values = {name: _numbers(value) for name, value in given.items()}
         for name, value in given.items():
             if values[name] is None and not _symbolic(value):
-                raise ArgumentError(f"{self._where()}: argument {name} must be numbers or a CasADi expression, got "
-                                    f"{type(value).__name__} {value!r:.60}")
+                raise ArgumentError(f"{self._where()}: argument {name} must be real numbers or a CasADi expression, "
+                                    f"got {type(value).__name__} {value!r:.60}")
         numeric = all(v is not None for v in values.values())
         for name, value in values.items():
             if value is not None:
@@ -121,11 +121,11 @@ class CheckedFunction(ca.Function):
                 continue
             array = value.full().ravel(order="F")
             first = int(np.flatnonzero(~np.isfinite(array))[0])
-            at = "; ".join(f"{n} = {np.array2string(v.ravel(), precision=6, separator=', ')}"
+            at = "; ".join(f"{n} = {np.array2string(v.ravel(), precision=6, separator=', ', max_line_width=10**9)}"
                            for n, v in values.items() if v.size)
             raise ArgumentError(f"{self._where()}: output {name} {self._entry(name, first, array.size)} is "
-                                f"{array[first]} at finite arguments ({at}); the point is outside the "
-                                "equations' domain")
+                                f"{array[first]} at finite arguments ({at}); the point is outside the equations' "
+                                "domain or overflows double precision")
 
     def _entry(self, name: str, index: int, size: int) -> str:
         labels = self._labels.get(name, ())
@@ -139,11 +139,14 @@ def checked(function: ca.Function, owner: str, labels: Mapping[str, tuple[str, .
 
 
 def _numbers(value) -> np.ndarray | None:
-    """A float array of a numeric argument; None for a symbolic one (SX, MX or lists of them)."""
-    if isinstance(value, (ca.SX, ca.MX)):
+    """A float array of a numeric argument; None for a symbolic one (SX, MX or lists of them) and for what is not
+    real numbers (None, complex, text: the caller names it)."""
+    if value is None or isinstance(value, (ca.SX, ca.MX)):
         return None
     if isinstance(value, ca.DM):
         return np.asarray(value.full(), dtype=float)
+    if np.iscomplexobj(value):
+        return None
     try:
         return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
