@@ -243,3 +243,30 @@ def test_each_integrator_is_built_with_its_documented_defaults_under_the_runs_ow
         simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method="collocation",
                         options={"number_of_finite_elements": 3, "bogus": 1})
     assert "with options {'number_of_finite_elements': 3, 'bogus': 1}: " in str(error.value)
+
+
+def test_integrator_options_are_checked_where_a_user_gives_them():
+    """A NaN tolerance would hang SUNDIALS; a string or options for the fast method would be a raw TypeError or
+    silently ignored: each is refused by name before the run, by simulate_system and by simulate."""
+    from dataclasses import replace
+
+    from uvsym.sim.scenario import load_scenario
+    from uvsym.sim.simulation import simulate_scenario
+
+    hold = open_loop("hold", [0.0], [0.0], publishes=["u"])
+    refused = [("idas", {"abstol": float("nan")}, r"^options\['abstol'\] is nan; an integrator option must be finite$"),
+               ("collocation", {"rootfinder_options": {"abstol": float("inf")}},
+                r"^options\['rootfinder_options'\]\['abstol'\] is inf; an integrator option must be finite$"),
+               ("cvodes", "abstol=1e-6",
+                r"^options must be a dict of CasADi integrator options, got str 'abstol=1e-6'$"),
+               ("rk", {1: 2}, r"^options: option names are text, got 1$"),
+               ("fast", {"number_of_finite_elements": 3},
+                r"^options \['number_of_finite_elements'\] go to a CasADi integrator .*the fast method takes none")]
+    docking = replace(load_scenario("docking_faults"), duration=0.1)
+    for method, options, message in refused:
+        with pytest.raises(SimulationError, match=message):
+            simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method=method, options=options)
+        with pytest.raises(SimulationError, match=message):
+            simulate_scenario(docking, method=method, options=options)
+    result = simulate_system(integrator(), [hold], duration=0.1, dt=0.1, x0=[0.0], method="fast", options={})
+    assert result.t[-1] == pytest.approx(0.1)  # empty options are no options
