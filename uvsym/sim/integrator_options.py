@@ -1,6 +1,6 @@
-"""The integrator options a run is given (``simulate(..., options=...)``, ``simulate_system``), checked where the
-user gives them: a dict for a CasADi integrator method, with finite numbers (SUNDIALS loops forever on a NaN
-tolerance). Option names are CasADi's to check (its message names the refused option's plugin)."""
+"""The integrator options a run is given (``simulate(..., options=...)``, ``simulate_system``), checked before
+the run: a dict for a CasADi integrator method, with finite numbers (SUNDIALS loops forever on a NaN
+tolerance). Option names are CasADi's to check: it refuses an unknown one when the integrator is built."""
 
 from __future__ import annotations
 
@@ -21,8 +21,9 @@ def checked_options(method: str, options) -> dict:
     if options and method == "fast":
         raise SimulationError(f"options {sorted(map(str, options))} go to a CasADi integrator (cvodes, idas, rk, "
                               "collocation); the fast method takes none (its steps per sample: substeps)")
-    _check_entries(dict(options), "options")
-    return dict(options)
+    options = dict(options)
+    _check_entries(options, "options")
+    return options
 
 
 def _check_entries(options: dict, where: str) -> None:

@@ -28,6 +28,7 @@ import numpy as np
 from uvsym.codegen import compile_roll, find_compiler
 from uvsym.errors import CodegenError, SimulationError, UvsymError
 from uvsym.observers.ftc import Correction
+from uvsym.sim.integrator_options import checked_options
 from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
 
@@ -80,11 +81,13 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     Raises
     ------
     SimulationError
-        For an unknown method or supervisor period, or a loop whose signals become non-finite
-        (names the first signal entry and the time).
+        For an unknown method or supervisor period, options refused by
+        :func:`~uvsym.sim.integrator_options.checked_options`, or a loop whose signals become
+        non-finite (names the first signal entry and the time).
     """
     if method not in METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+    options = checked_options(method, options)
     N = W.shape[0] - 1
     if supervisor is not None:
         period = getattr(supervisor, "period", None)
@@ -95,7 +98,7 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
         chunk = CHUNK["fast" if method == "fast" else "integrator"]
     W = np.ascontiguousarray(W, dtype=float)
     outputs = np.empty((N + 1, loop.discrete.size1_out("out")))
-    advance, build_s = _stepper(loop, method, min(chunk, N), options or {}, compiled)
+    advance, build_s = _stepper(loop, method, min(chunk, N), options, compiled)
     z = np.asarray(z0, dtype=float)
     started = time.perf_counter()
     for start in range(0, N, chunk):

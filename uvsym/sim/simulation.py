@@ -19,7 +19,6 @@ from uvsym.observers.discrete import actuator_fault_observer
 from uvsym.observers.gains import design_gains
 from uvsym.sim.closed_loop import ClosedLoop, actuator_fault_columns, build_closed_loop
 from uvsym.sim.controllers import Autopilot
-from uvsym.sim.integrator_options import checked_options
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
@@ -69,7 +68,6 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
     fault_actuator (u_actual - healthy), fault_sensor (y - x), tau_desired, reference and
     f_hat/<observer>, one row per grid time ``0, dt, ..., duration``.
     """
-    options = checked_options(method, options)
     run = prepare_run(model, controller, duration=duration, dt=dt, eta0=eta0, nu0=nu0, actuators0=actuators0,
                       current=current, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                       observers=observers, method=method, substeps=substeps, seed=seed)

@@ -6,7 +6,6 @@ import numpy as np
 
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault
-from uvsym.sim.integrator_options import checked_options
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
@@ -59,7 +58,6 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     publishes, named by the block), fault_sensor (y - h(x, u)), fault_actuator (u - commanded)
     and, with substitutions, substitution (each channel's switch, 0 or 1).
     """
-    options = checked_options(method, options)
     N = grid(duration, dt)
     for what, faults in (("actuator_faults", actuator_faults), ("sensor_faults", sensor_faults)):
         late = [i for i, f in enumerate(faults) if not f.profile.onset < duration]
