@@ -145,10 +145,9 @@ def _numbers(value) -> np.ndarray | None:
         return None
     if isinstance(value, ca.DM):
         return np.asarray(value.full(), dtype=float)
-    if np.iscomplexobj(value):
-        return None
     try:
-        return np.asarray(value, dtype=float)
+        array = np.asarray(value)  # converted once: complex is refused, not cut to its real part
+        return None if np.iscomplexobj(array) else np.asarray(array, dtype=float)
     except (TypeError, ValueError):
         return None
 
