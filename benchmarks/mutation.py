@@ -270,6 +270,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--before", action="store_true",
                         help="record this run as the baseline (key 'before') and leave the last results as they are")
     args = parser.parse_args(argv)
+    for name in ("max_children", "sample"):
+        if getattr(args, name) is not None and getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be at least 1, got {getattr(args, name)}")
+    if args.again and not (args.again / "pyproject.toml").is_file():
+        parser.error(f"--again {args.again}: not a folder an earlier run kept with --keep (no pyproject.toml there)")
+    if args.suspect and not args.again:
+        parser.error("--suspect re-tests kills of a kept run: give --again FOLDER with it")
+    if args.suspect and not args.suspect.is_file():
+        parser.error(f"--suspect {args.suspect}: no such file")
     config = _config()
     available = configured_modules(config)
     if args.again:

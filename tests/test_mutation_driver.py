@@ -124,3 +124,21 @@ def test_the_readme_quotes_the_committed_mutation_results():
     assert (killed, equivalent) == (sum(r["killed"] for r in records), sum(r["equivalent"] for r in records))
     surviving = sum(r["survived"] for r in records)
     assert quoted.group(5) == ("none" if surviving == 0 else str(surviving))
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--sample", "0"], "--sample must be at least 1, got 0"),
+    (["--max-children", "-2"], "--max-children must be at least 1, got -2"),
+    (["--again", "{missing}"], "--again {missing}: not a folder an earlier run kept with --keep"),
+    (["--suspect", "{tests}"], "--suspect re-tests kills of a kept run: give --again FOLDER with it"),
+    (["--again", "{kept}", "--suspect", "{missing}"], "--suspect {missing}: no such file"),
+])
+def test_mistaken_arguments_are_refused_before_any_run(tmp_path, capsys, argv, message):
+    kept, tests = tmp_path / "kept", tmp_path / "suspects.txt"
+    kept.mkdir()
+    (kept / "pyproject.toml").write_text('[tool.mutmut]\nonly_mutate = ["uvsym/faults.py"]\n')
+    tests.write_text("tests/test_faults.py::test_x\n")
+    places = {"missing": tmp_path / "missing", "kept": kept, "tests": tests}
+    with pytest.raises(SystemExit):
+        mutation.main([a.format(**places) for a in argv])
+    assert message.format(**places) in capsys.readouterr().err
