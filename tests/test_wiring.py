@@ -200,8 +200,8 @@ def test_a_read_nobody_publishes_names_the_block_the_signal_and_the_published_on
         interconnect(first_order(), [_feedback("speed", "F")], dt=DT)
 
 
-def test_a_signal_published_twice_is_refused():
-    with pytest.raises(WiringError, match=r"signal 'F' is published twice: by block a and by block b"):
+def test_a_plant_input_two_blocks_publish_is_refused():
+    with pytest.raises(WiringError, match=r"plant first_order input 'F' is driven by blocks a and b; rename"):
         interconnect(first_order(), [_feedback("m", "F", "a"), _feedback("m", "F", "b")], dt=DT)
 
 

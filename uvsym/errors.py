@@ -71,8 +71,8 @@ class ObserverError(UvsymError, ValueError):
 
 
 class WiringError(UvsymError, ValueError):
-    """Blocks cannot be joined into a loop (names the signal: unread, published twice, undriven
-    plant input, algebraic loop)."""
+    """Blocks cannot be joined into a loop (names the signal: unread, ambiguous, undriven plant
+    input, algebraic loop)."""
 
 
 class CodegenError(UvsymError, RuntimeError):

@@ -2,8 +2,13 @@
 
 The loop publishes its time ``t`` (s); the plant publishes its measured outputs under its output
 names and reads its inputs under its input names; each block reads and publishes the signals its
-Signals name. A read named N gets the one signal published as N; a read named ``N.raw`` gets N
-as published, never substituted (unless some block publishes ``N.raw`` itself).
+Signals name. A signal block B publishes as N is read as ``B.N``, a measured output N as ``y.N``
+(``y``: the group of measured outputs), and either as the bare N while no other block or output
+publishes N; a bare N published more than once is a WiringError only when read, naming the
+qualified choices. Nothing but the loop publishes ``t``, and no published name may be another
+signal's qualified one. The loop's names (``names``, ``units``, ``order``) are bare where the bare
+name reads the signal, qualified otherwise. A read named ``N.raw`` gets N (bare or qualified) as
+published, never substituted (unless some block publishes ``N.raw`` itself).
 
 State ``z = [x (n_x); s of each block, in order; held (n_y)]``: plant state, block states, and
 the outputs latched at the last sample before a stuck sensor fault. Per-sample input
@@ -18,13 +23,14 @@ time (the fixed-step RK4 path smears a fault that switches inside a sample over 
 the CasADi integrators, or onsets on the sample grid, avoid it). A discrete-time plant (its
 ``dt`` equal to the loop's) steps ``x_{k+1} = f_d(x_k, u_f(u_k, t_k), d_k, p)`` instead, on the
 fast path only. Measurement substitution
-``{"psi": "psi_hat"}``: while channel psi is on, every block that reads ``psi`` gets ``psi_hat``
-instead, except the block publishing ``psi_hat`` (an estimator keeps seeing its sensor); switches
-are columns of w, set by a supervisor's ``Substitution``.
+``{"psi": "psi_hat"}``: while channel psi is on, every block that reads ``psi`` (under any of its
+names but ``.raw``) gets ``psi_hat`` instead, except the block publishing ``psi_hat`` (an estimator
+keeps seeing its sensor); switches are columns of w, set by a supervisor's ``Substitution``.
 """
 
 from __future__ import annotations
 
+import difflib
 import graphlib
 from dataclasses import dataclass
 
@@ -86,41 +92,87 @@ def _check(plant: System, blocks: tuple[Block, ...], dt: float, substeps: int) -
             raise WiringError(f"block {b.name} was designed for dt = {b.dt} s; the loop samples every {dt} s")
 
 
-def _publishers(plant: System, blocks: tuple[Block, ...]) -> tuple[dict[str, str], dict[str, str]]:
-    """(signal -> who publishes it, signal -> unit it declares); WiringError for a name published twice."""
-    who, units = {"t": "the loop"}, {"t": "s"}
-    groups = [(f"plant {plant.name}", plant.y)] + [(f"block {b.name}", b.publishes) for b in blocks]
-    for label, group in groups:
+@dataclass(frozen=True)
+class _Published:
+    """who: canonical name -> its publisher; units: canonical name -> its declared unit; alias: each
+    name that reads one signal (bare or qualified) -> its canonical name; shared: each bare name
+    published more than once -> the canonical (qualified) names of its signals."""
+
+    who: dict[str, str]
+    units: dict[str, str]
+    alias: dict[str, str]
+    shared: dict[str, list[str]]
+
+
+def _listing(items: list[str], last: str = "and") -> str:
+    return f"{', '.join(items[:-1])} {last} {items[-1]}" if len(items) > 1 else items[0]
+
+
+def _publishers(plant: System, blocks: tuple[Block, ...]) -> _Published:
+    """The loop's signals (module docstring); WiringError for a published ``t`` (the loop's time) or
+    a published name that is another signal's qualified name."""
+    groups = [("y", f"plant {plant.name}", plant.y)] + [(b.name, f"block {b.name}", b.publishes) for b in blocks]
+    by_name: dict[str, list[str]] = {}
+    for _, label, group in groups:
+        for name in group.names:
+            by_name.setdefault(name, []).append(label)
+    published = _Published({"t": "the loop"}, {"t": "s"}, {"t": "t"}, {})
+    for key, label, group in groups:
         for name, unit in zip(group.names, group.units):
-            if name in who:
-                raise WiringError(f"signal {name!r} is published twice: by {who[name]} and by {label}")
-            who[name], units[name] = label, unit
-    return who, units
+            qualified = f"{key}.{name}"
+            if name == "t":
+                raise WiringError(f"{label} publishes 't', the name of the loop's time (s)")
+            if qualified in by_name:
+                raise WiringError(f"{label} publishes {name!r}, read as {qualified!r}, a name "
+                                  f"{_listing(by_name[qualified])} also publishes")
+            canonical = name if len(by_name[name]) == 1 else qualified
+            published.who[canonical], published.units[canonical] = label, unit
+            published.alias[qualified] = canonical
+            if canonical == name:
+                published.alias[name] = name
+            else:
+                published.shared.setdefault(name, []).append(canonical)
+    return published
 
 
-def _source(name: str, who: dict[str, str], reader: str, plant: System) -> str:
-    """The published signal a read of ``name`` joins (N for ``N.raw``); WiringError if none."""
-    base = name[:-len(RAW)] if name.endswith(RAW) and name not in who else name
-    if base in who:
-        return base
-    known = ", ".join(sorted(who))
-    if reader == f"plant {plant.name}":
-        raise WiringError(f"plant {plant.name} input {name!r} is driven by no block; published: {known}")
+def _source(name: str, published: _Published, reader: str, plant: System) -> tuple[str, bool]:
+    """(the canonical signal a read of ``name`` joins, whether it reads it raw: ``N.raw``);
+    WiringError if nothing publishes it, or for a bare name several publish."""
+    alias, shared = published.alias, published.shared
+    raw = name.endswith(RAW) and name not in alias and name not in shared
+    base = name[:-len(RAW)] if raw else name
+    if base in alias:
+        return alias[base], raw
+    driven = f"plant {plant.name} input {name!r} is driven by" if reader == f"plant {plant.name}" else ""
+    if base in shared:
+        labels = [published.who[c] for c in shared[base]]
+        if all(label.startswith("block ") for label in labels):
+            labels = [f"blocks {_listing([label.removeprefix('block ') for label in labels])}"]
+        if driven:
+            raise WiringError(f"{driven} {_listing(labels)}; rename all but one (uvsym.sim.renamed)")
+        choices = _listing([f"'{c}{name[len(base):]}'" for c in shared[base]], "or")
+        raise WiringError(f"{reader} reads {name!r}, which {_listing(labels)} "
+                          f"{'both' if len(shared[base]) == 2 else 'all'} publish; read {choices}")
+    close = difflib.get_close_matches(name, [*alias, *shared])
+    known = ", ".join(sorted(published.who)) + (f"; did you mean {_listing([repr(c) for c in close], 'or')}?"
+                                                 if close else "")
+    if driven:
+        raise WiringError(f"{driven} no block; published: {known}")
     raise WiringError(f"{reader} reads {name!r}, which nothing publishes; published: {known}")
 
 
-def _resolve_units(readers: list[tuple[str, Signals]], who: dict, declared: dict, plant: System) -> dict:
+def _resolve_units(readers: list[tuple[str, Signals]], published: _Published, plant: System) -> dict:
     """Units of every published signal: the publisher's, else the first reader's; WiringError on a mismatch."""
-    units = dict(declared)
+    units = dict(published.units)
     for reader, group in readers:
         for name, unit in zip(group.names, group.units):
-            source = _source(name, who, reader, plant)
+            source = _source(name, published, reader, plant)[0]
             units[source] = units[source] or unit
     for reader, group in readers:
         for name, unit in zip(group.names, group.units):
-            source = _source(name, who, reader, plant)
+            source = _source(name, published, reader, plant)[0]
             if unit and unit != units[source]:
-                raise WiringError(f"{reader} reads {name!r} in {unit!r} but {who[source]} publishes it in "
+                raise WiringError(f"{reader} reads {name!r} in {unit!r} but {published.who[source]} publishes it in "
                                   f"{units[source]!r}")
     return units
 
@@ -131,7 +183,8 @@ def _resolve(exprs: dict[str, ca.SX], P: dict[str, ca.SX], who: dict[str, str],
 
     ``exprs[n]`` is signal n in terms of the placeholders ``P`` of the signals it reads; the
     dependencies are the structural ones (``jacobian_sparsity``), sorted topologically, then each
-    placeholder is replaced by its signal in that order. WiringError naming a cycle.
+    placeholder is replaced by its signal in that order. WiringError naming a cycle (substitutions:
+    channel, as given, -> its substitute's canonical name).
     """
     names = list(P)
     pattern = ca.jacobian_sparsity(ca.vertcat(*[exprs[n] for n in names]), ca.vertcat(*[P[n] for n in names]))
@@ -165,9 +218,11 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     Raises
     ------
     WiringError
-        For a read nobody publishes (names the block, the signal and the published ones), a signal
-        published twice, a plant input no block drives, an algebraic loop (names the cycle), an
-        unknown substitution, a unit mismatch, or a block designed for another sample period.
+        For a read nobody publishes (names the block, the signal, the published ones and close
+        names), a bare read of a name several publish (names the qualified choices), a published
+        ``t`` or qualified name of another signal, a plant input no block drives, an algebraic loop
+        (names the cycle), an unknown substitution or a channel given twice, a unit mismatch, or a
+        block designed for another sample period.
     """
     blocks = tuple(blocks)
     _check(plant, blocks, dt, substeps)
@@ -177,14 +232,18 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     if raw:
         raise WiringError(f"substitutions {', '.join(raw)}: a substitution joins two published signals; "
                           f"'{RAW}' is only for reading a sensor past its substitution")
-    who, declared = _publishers(plant, blocks)
+    published = _publishers(plant, blocks)
+    canonical = published.alias
     plant_label = f"plant {plant.name}"
     readers = [(f"block {b.name}", b.reads) for b in blocks] + [(plant_label, plant.u)]
-    readers += [(f"substitution {c!r} -> {s!r}", Signals((c, s), ("", ""))) for c, s in substitutions.items()]
-    units = _resolve_units(readers, who, declared, plant)
-    for channel, substitute in substitutions.items():  # one quantity: an empty unit is the other's
+    units = _resolve_units(readers, published, plant)
+    pairs = [tuple(_source(n, published, f"substitution {c!r} -> {s!r}", plant)[0] for n in (c, s))
+             for c, s in substitutions.items()]  # (channel, substitute), canonical names
+    if len({channel for channel, _ in pairs}) < len(pairs):
+        raise WiringError(f"substitutions {list(substitutions)} name one channel twice")
+    for (c, s), (channel, substitute) in zip(substitutions.items(), pairs):  # an empty unit is the other's
         if units[channel] and units[substitute] and units[channel] != units[substitute]:
-            raise WiringError(f"substitution {channel!r} -> {substitute!r}: units {units[channel]!r} and "
+            raise WiringError(f"substitution {c!r} -> {s!r}: units {units[channel]!r} and "
                               f"{units[substitute]!r} differ")
         units[channel] = units[substitute] = units[channel] or units[substitute]
 
@@ -196,16 +255,16 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     z, w = ca.SX.sym("z", n_z), ca.SX.sym("w", n_w)
     x, held, t = z[layout["x"]], z[layout["held"]], w[0]
     noise, d, on = w[1:1 + n_y], w[1 + n_y:1 + n_y + n_d], w[1 + n_y + n_d:]
-    switch = {channel: on[i] for i, channel in enumerate(substitutions)}
-    P = {name: ca.SX.sym(name) for name in who}
+    switch = {channel: (on[i], substitute) for i, (channel, substitute) in enumerate(pairs)}
+    P = {name: ca.SX.sym(name) for name in published.who}
 
     def read(reader: str, group: Signals) -> ca.SX:
         values = []
         for name in group.names:
-            source = _source(name, who, reader, plant)
+            source, raw = _source(name, published, reader, plant)
             value = P[source]
-            if name in switch and who[substitutions[name]] != reader:
-                value = ca.if_else(switch[name], P[substitutions[name]], value)
+            if source in switch and not raw and published.who[switch[source][1]] != reader:
+                value = ca.if_else(switch[source][0], P[switch[source][1]], value)
             values.append(value)
         return _column(values)
 
@@ -214,18 +273,18 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
         reads.append(read(f"block {b.name}", b.reads))
         s_b, out_b = b.step(z[layout[b.name]], reads[-1])
         s_next.append(s_b)
-        exprs.update({name: out_b[i] for i, name in enumerate(b.publishes.names)})
+        exprs.update({canonical[f"{b.name}.{n}"]: out_b[i] for i, n in enumerate(b.publishes.names)})
     u_cmd = read(plant_label, plant.u)
     u_applied = apply_actuator_faults(u_cmd, t, actuator_faults)
     y_true = plant.h(x, u_applied, p)
     y, held_next = apply_sensor_faults(y_true, t, sensor_faults, held, noise)
-    exprs.update({name: y[i] for i, name in enumerate(plant.y.names)})
-    order, values = _resolve(exprs, P, who, substitutions)
+    exprs.update({canonical[f"y.{n}"]: y[i] for i, n in enumerate(plant.y.names)})
+    order, values = _resolve(exprs, P, published.who, {c: s for c, (_, s) in zip(substitutions, pairs)})
     parts = {"x": (x, plant.x, plant.x.units), "y": (y, plant.y, plant.y.units),
              "u": (u_applied, plant.u, plant.u.units)}
     for b in blocks:
-        parts[b.name] = (_column([exprs[n] for n in b.publishes.names]), b.publishes,
-                         tuple(units[n] for n in b.publishes.names))
+        own = [canonical[f"{b.name}.{n}"] for n in b.publishes.names]
+        parts[b.name] = (_column([exprs[n] for n in own]), b.publishes, tuple(units[n] for n in own))
     parts["fault_sensor"] = (y - y_true, plant.y, plant.y.units)
     parts["fault_actuator"] = (u_applied - u_cmd, plant.u, plant.u.units)
     if substitutions:
