@@ -32,7 +32,7 @@ scenario = dataclasses.replace(scenario, duration=30.0, actuator_faults=faults, 
 result = simulate_scenario(scenario)
 for e in result.events:
     value = "" if e["value"] is None else f" {e['value']:.4g}"
-    print(f"{e['t']:6.2f} s  {e['event']:<10} {e['actuator'] or ''} {e['kind'] or ''}{value}")
+    print(f"{e['t']:6.2f} s  {e['event']:<10} {e['target'] or ''} {e['kind'] or ''}{value}")
 out.mkdir(parents=True, exist_ok=True)
 log = write_events(result.events, out / "events.json")
 print(f"wrote {log}")

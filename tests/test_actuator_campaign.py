@@ -15,14 +15,14 @@ from uvsym.sim.scenario import load_scenario
 
 def _row(**fields):
     row = {"status": "ok", "true_actuator": "X", "true_kind": "bias", "identifiable": True, "excited": True,
-           "isolated_actuator": "X", "isolated_kind": "bias", "size_error_rel": 0.01, "isolation_delay_s": 1.0,
+           "isolated_target": "X", "isolated_kind": "bias", "size_error_rel": 0.01, "isolation_delay_s": 1.0,
            "false_alarms": 0}
     return row | fields
 
 
 def test_counts_use_only_identifiable_excited_runs_and_fault_free_false_alarms():
     rows = [_row(), _row(size_error_rel=0.03, isolation_delay_s=3.0),  # counted: one right, one too far off
-            _row(excited=False, isolated_actuator=None, isolated_kind=None, size_error_rel=None),  # left out
+            _row(excited=False, isolated_target=None, isolated_kind=None, size_error_rel=None),  # left out
             _row(true_actuator=None, true_kind=None, false_alarms=2),  # fault-free run with two alarms
             _row(status="error")]
     figures = counts(rows)

@@ -226,7 +226,7 @@ TRUTH = {"n_faults": 1, "true_actuator": "X", "true_sensor": None, "true_kind": 
 
 
 def _event(t, event, actuator=None, kind=None, value=None):
-    return {"t": t, "event": event, "actuator": actuator, "kind": kind, "value": value}
+    return {"t": t, "event": event, "target": actuator, "kind": kind, "value": value}
 
 
 def test_metrics_of_a_hand_written_event_log():
@@ -241,7 +241,7 @@ def test_metrics_of_a_hand_written_event_log():
               _event(13.0, "ambiguous", "X|delta_ru")]
     metrics = event_metrics(TRUTH, events[::-1])                # order of the list does not matter
     assert metrics == {"events": 9, "detected": True, "detection_delay_s": pytest.approx(0.8),
-                       "isolated_actuator": "X", "isolated_kind": "bias", "isolated_actuators": "X",
+                       "isolated_target": "X", "isolated_kind": "bias", "isolated_targets": "X",
                        "isolation_delay_s": pytest.approx(2.5),
                        "identified_value": 10.4, "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
                        "ambiguous": True, "unexcited": False}
@@ -255,12 +255,12 @@ def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
     metrics = event_metrics(truth_row, events)
     assert metrics["false_alarms"] == 1 and metrics["detection_delay_s"] == pytest.approx(1.0)
     assert metrics["identified_value"] == 3.0 and metrics["size_error_rel"] == pytest.approx(0.7)
-    assert metrics["isolated_actuator"] is None and metrics["unexcited"] is True
+    assert metrics["isolated_target"] is None and metrics["unexcited"] is True
     assert event_metrics(truth_row, [_event(32.0, "unexcited", "delta_e")])["unexcited"] is False
     healthy = {key: None for key in TRUTH} | {"n_faults": 0}
     metrics = event_metrics(healthy, [_event(3.0, "detected"), _event(4.0, "isolated", "X", "bias")])
     assert metrics["false_alarms"] == 2 and metrics["detected"] is False and metrics["detection_delay_s"] is None
-    assert metrics["isolated_actuator"] == "X"
+    assert metrics["isolated_target"] == "X"
 
 
 def test_the_final_isolation_is_the_last_one_standing():
@@ -269,11 +269,11 @@ def test_the_final_isolation_is_the_last_one_standing():
               _event(8.0, "isolated", "delta_rd", "proportional"), _event(9.0, "cleared", "delta_rd"),
               _event(10.0, "isolated", "X", "constant")]  # X again: now the latest
     metrics = event_metrics(TRUTH, events)
-    assert (metrics["isolated_actuator"], metrics["isolated_kind"]) == ("X", "constant")
-    assert metrics["isolated_actuators"] == "delta_ru|X" and metrics["isolation_delay_s"] == pytest.approx(1.0)
+    assert (metrics["isolated_target"], metrics["isolated_kind"]) == ("X", "constant")
+    assert metrics["isolated_targets"] == "delta_ru|X" and metrics["isolation_delay_s"] == pytest.approx(1.0)
     metrics = event_metrics(TRUTH, events[:4])
-    assert (metrics["isolated_actuator"], metrics["isolated_actuators"]) == ("delta_ru", "X|delta_ru")
-    assert event_metrics(TRUTH, events + [_event(11.0, "cleared")])["isolated_actuators"] is None
+    assert (metrics["isolated_target"], metrics["isolated_targets"]) == ("delta_ru", "X|delta_ru")
+    assert event_metrics(TRUTH, events + [_event(11.0, "cleared")])["isolated_targets"] is None
 
 
 def test_truth_and_path_error_of_a_run():
@@ -399,5 +399,6 @@ def test_a_dask_worker_killed_under_a_chunk_has_the_chunk_rerun_run_by_run(tmp_p
 def test_a_study_scenario_is_named_as_such(tmp_path):
     """compass_10deg is shipped with the sensor-fdi-lms study, not as a vehicle scenario: the error says so."""
     text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1]\n'
-    with pytest.raises(CampaignError, match="scenario of the sensor-fdi-lms study: campaigns take vehicle scenarios"):
+    with pytest.raises(CampaignError, match="scenario of the sensor-fdi-lms study, whose experiments do not run in "
+                                             "campaigns yet"):
         load_campaign(_write(tmp_path, text))

@@ -87,9 +87,9 @@ def test_a_late_fault_is_found_isolated_and_sized(actuator, kind, value):
     events = events_of(docking([(actuator, kind, value, Profile(onset=onset))], duration=16.0))
     assert all(e["t"] >= onset for e in events if e["event"] != "unexcited")  # nothing before the onset
     isolated = [e for e in events if e["event"] == "isolated"]
-    assert isolated and isolated[0]["actuator"] == actuator and isolated[0]["kind"] == kind
+    assert isolated and isolated[0]["target"] == actuator and isolated[0]["kind"] == kind
     assert isolated[0]["t"] - onset <= 2.0
-    identified = [e for e in events if e["event"] == "identified" and e["actuator"] == actuator]
+    identified = [e for e in events if e["event"] == "identified" and e["target"] == actuator]
     assert identified and identified[0]["value"] == pytest.approx(value, rel=0.02)
 
 
@@ -97,7 +97,7 @@ def test_redundant_rudders_with_equal_faults_are_both_identified():
     """Both rudders at 0.8 from the start: no single rudder explains it; the pair is found and sized."""
     events = events_of(docking([("delta_ru", "proportional", 0.8, Profile()),
                                 ("delta_rd", "proportional", 0.8, Profile())], duration=8.0))
-    identified = {e["actuator"]: e["value"] for e in events if e["event"] == "identified"}
+    identified = {e["target"]: e["value"] for e in events if e["event"] == "identified"}
     assert set(identified) == {"delta_ru", "delta_rd"}
     assert identified["delta_ru"] == pytest.approx(0.8, rel=0.01)
     assert identified["delta_rd"] == pytest.approx(0.8, rel=0.01)
@@ -106,7 +106,7 @@ def test_redundant_rudders_with_equal_faults_are_both_identified():
 def test_an_intermittent_fault_is_cleared_and_found_again():
     profile = Profile(kind="intermittent", onset=4.0, period=16.0, duty=0.5)  # on 4-12 s, off 12-20 s, on 20-28 s
     events = events_of(docking([("X", "bias", 10.0, profile)], duration=26.0))
-    times = {kind: [e["t"] for e in events if e["event"] == kind and e["actuator"] == "X"]
+    times = {kind: [e["t"] for e in events if e["event"] == kind and e["target"] == "X"]
              for kind in ("isolated", "cleared")}
     assert len(times["isolated"]) == 2 and 4.0 < times["isolated"][0] < 6.0 and 20.0 < times["isolated"][1] < 22.0
     assert len(times["cleared"]) == 1 and 12.0 < times["cleared"][0] < 16.0
@@ -115,7 +115,7 @@ def test_an_intermittent_fault_is_cleared_and_found_again():
 def test_an_unexcited_actuator_is_not_declared_healthy_or_misjudged():
     """The elevator holds a near-constant trim: a proportional fault on it cannot be told from a bias."""
     events = events_of(docking([("delta_e", "proportional", 0.6, Profile(onset=5.0))], duration=14.0))
-    on_elevator = [e for e in events if e["actuator"] == "delta_e"]
+    on_elevator = [e for e in events if e["target"] == "delta_e"]
     assert any(e["event"] == "unexcited" for e in on_elevator)
     assert not [e for e in events if e["event"] == "isolated" and e["kind"] != "proportional"]
 
@@ -198,7 +198,7 @@ def test_cli_writes_the_decision_log(tmp_path, capsys):
     assert "faults standing at the end: X bias" in capsys.readouterr().out
     log = json.loads(out.read_text())
     assert [e["event"] for e in log][:2] == ["detected", "isolated"]
-    assert all(set(e) == {"t", "event", "actuator", "kind", "value"} for e in log)
+    assert all(set(e) == {"t", "event", "target", "kind", "value", "detector"} for e in log)
     assert main(["simulate", str(scenario_file), "--events", str(out)]) == 2
     assert "--force" in capsys.readouterr().err
     assert main(["simulate", "docking_faults", "--events", str(tmp_path / "x.json")]) == 2

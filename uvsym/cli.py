@@ -180,6 +180,12 @@ def _cmd_simulate(args) -> int:
     from uvsym.sim.result import SimResult
     from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
     from uvsym.sim.simulation import simulate_scenario
+    from uvsym.sim.system_scenario import (
+        SystemScenario,
+        is_system_scenario,
+        parse_system_scenario,
+        simulate_system_scenario,
+    )
 
     if args.schema:
         from uvsym.sim.schema import schema_markdown
@@ -195,7 +201,10 @@ def _cmd_simulate(args) -> int:
     if args.out:  # format, folder and an existing file checked before the run
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
-    scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
+    if is_system_scenario(table):
+        scenario = parse_system_scenario(table, default_name=path.stem, root=path.parent)
+    else:
+        scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
     if args.events is not None:
         _check_events_path(args.events, scenario, args.force)
     figure = None
@@ -208,17 +217,22 @@ def _cmd_simulate(args) -> int:
     else:
         method = args.method or "fast"
         bar = ProgressBar(f"{scenario.name} ({method})")
-        result = simulate_scenario(scenario, method=method, progress=bar)
+        if isinstance(scenario, SystemScenario):
+            result, what = simulate_system_scenario(scenario, method=method, progress=bar), scenario.plant.name
+        else:
+            result, what = simulate_scenario(scenario, method=method, progress=bar), scenario.model.name
         bar.close()
         wall = result.meta["wall_s"]
-        print(f"{scenario.name}: {scenario.model.name}, {scenario.duration:g} s at {scenario.step:g} s, method "
+        print(f"{scenario.name}: {what}, {scenario.duration:g} s at {scenario.step:g} s, method "
               f"{method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
               f"build {result.meta['build_s']:.2f} s")
         x = result["x"]
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
-    if scenario is not None and scenario.diagnosis is not None:
+    if _has_detectors(scenario):
+        print(_event_lines(result.events))
+    if getattr(scenario, "diagnosis", None) is not None:
         print(_decisions(result.events))
     if args.events:
         from uvsym.diagnosis.events import write_events
@@ -235,20 +249,37 @@ def _decisions(events: list[dict]) -> str:
     standing = {}
     for e in events:
         if e["event"] in ("isolated", "identified"):
-            standing[e["actuator"]] = e
+            standing[e["target"]] = e
         elif e["event"] == "cleared":
-            standing.pop(e["actuator"], None)
+            standing.pop(e["target"], None)
     faults = ", ".join(f"{a} {e['kind']} {e['value']:.4g} ({e['event']} at {e['t']:g} s)" for a, e in standing.items())
     return f"diagnosis: {len(events)} events; faults standing at the end: {faults or 'none'}"
 
 
+def _has_detectors(scenario) -> bool:
+    """True when the scenario decides anything: a vehicle's [diagnosis] table, or [[detectors]]."""
+    return getattr(scenario, "diagnosis", None) is not None or bool(getattr(scenario, "detectors", ()))
+
+
+def _event_lines(events: list[dict]) -> str:
+    """Every detector's decisions, one line per event: time, detector, event, target, kind and value."""
+    if not events:
+        return "decisions: none (no detector logged an event)"
+    lines = ["decisions:"]
+    for e in events:
+        value = "" if e["value"] is None else f" {e['value']:.4g}"
+        lines.append(f"  {e['t']:>10.4f} s  {e['detector'] or '-':<16} {e['event']:<11} {e['target'] or '-'}"
+                     + (f" {e['kind']}" if e["kind"] else "") + value)
+    return "\n".join(lines)
+
+
 def _check_events_path(path, scenario, force: bool) -> None:
-    """UvsymError before the run: --events needs a scenario with a [diagnosis] table, a .json file whose
-    folder exists, and --force to replace a file."""
+    """UvsymError before the run: --events needs a scenario with detectors (a vehicle's [diagnosis] table
+    or [[detectors]]), a .json file whose folder exists, and --force to replace a file."""
     target = Path(path)
-    if scenario is None or scenario.diagnosis is None:
-        raise UvsymError("--events: the scenario has no [diagnosis] table, so there is no decision log to write "
-                         "(uvsym simulate --schema lists the table's fields)")
+    if not _has_detectors(scenario):
+        raise UvsymError("--events: the scenario has no detector ([diagnosis] for a vehicle, [[detectors]] for a "
+                         "plant), so there is no decision log to write (uvsym simulate --schema lists the fields)")
     if not str(path).strip() or target.suffix != ".json":
         raise UvsymError(f"--events: {path} must end in .json")
     if not target.parent.is_dir():

@@ -63,7 +63,7 @@ def metrics(scenario, result, events) -> dict:
 
 def correct(row: dict) -> bool:
     """The run's standing decision names the true actuator and kind, and the size is within tolerance."""
-    return (row["isolated_actuator"] == row["true_actuator"] and row["isolated_kind"] == row["true_kind"]
+    return (row["isolated_target"] == row["true_actuator"] and row["isolated_kind"] == row["true_kind"]
             and row["size_error_rel"] is not None and row["size_error_rel"] <= SIZE_TOLERANCE)
 
 

@@ -26,7 +26,7 @@ __all__ = ["campaign_results", "corrected_docking", "TABLE_COLUMNS"]
 
 # the columns of campaign_results.csv (the run's wall time is left out: the file stays the same)
 TABLE_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "identifiable", "excited",
-                 "detected", "detection_delay_s", "isolated_actuator", "isolated_kind", "isolation_delay_s",
+                 "detected", "detection_delay_s", "isolated_target", "isolated_kind", "isolation_delay_s",
                  "identified_value", "size_error_rel", "false_alarms", "ambiguous", "status", "error")
 
 
@@ -35,9 +35,9 @@ def _vehicle(case: str) -> str:
 
 
 def _decided(row: dict) -> str:
-    if row["isolated_actuator"] is None:
+    if row["isolated_target"] is None:
         return "ambiguous" if row["ambiguous"] else "none"
-    return f"{row['isolated_kind']} {row['isolated_actuator']}"
+    return f"{row['isolated_kind']} {row['isolated_target']}"
 
 
 def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dict:
@@ -51,7 +51,7 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     counted = [r for r in faulty if r["identifiable"] and r["excited"]]
     confusion = Counter((f"{r['true_kind']} {r['true_actuator']}", _decided(r)) for r in counted)
     wrong = [{key: r[key] for key in ("case", "true_actuator", "true_kind", "true_value", "onset_s",
-                                      "isolated_actuator", "isolated_kind", "identified_value", "size_error_rel")}
+                                      "isolated_target", "isolated_kind", "identified_value", "size_error_rel")}
              for r in counted if not correct(r)]
     excluded = Counter((_vehicle(r["case"]), r["true_actuator"], r["true_kind"]) for r in faulty
                        if not (r["identifiable"] and r["excited"]))
@@ -76,7 +76,7 @@ def corrected_docking(progress) -> dict:
     scenario = load_scenario("docking_diagnosis")
     progress(f"docking with the continuous diagnosis in the loop ({scenario.name})")
     result = simulate_scenario(scenario)
-    identified = {e["actuator"]: {"kind": e["kind"], "value": e["value"], "time_s": e["t"]}
+    identified = {e["target"]: {"kind": e["kind"], "value": e["value"], "time_s": e["t"]}
                   for e in result.events if e["event"] == "identified"}
     isolated = [e["t"] for e in result.events if e["event"] == "isolated"]
     return {"scenario": scenario.name, "events": result.events, "identified": identified,

@@ -211,10 +211,10 @@ def continuous_section(c: dict) -> str:
     kinds = [[k, v["runs"], v["correct"], _fmt(v["median_size_error_rel"], 3), _fmt(v["max_size_error_rel"], 3)]
              for k, v in f["by_kind"].items()]
     wrong = [[w["case"], f"{w['true_kind']} {w['true_actuator']} {_fmt(w['true_value'], 3)}", _fmt(w["onset_s"], 3),
-              f"{w['isolated_kind']} {w['isolated_actuator']}", _fmt(w["identified_value"], 4),
+              f"{w['isolated_kind']} {w['isolated_target']}", _fmt(w["identified_value"], 4),
               _fmt(w["size_error_rel"], 3)] for w in f["wrong"]]
     excluded = [[e["vehicle"], e["actuator"], e["kind"], e["runs"]] for e in f["excluded"]]
-    events = [[_fmt(e["t"], 4), e["event"], e["actuator"], e["kind"] or "", _fmt(e["value"], 5) if e["value"]
+    events = [[_fmt(e["t"], 4), e["event"], e["target"], e["kind"] or "", _fmt(e["value"], 5) if e["value"]
                is not None else ""] for e in d["events"]]
     return f"""## Continuous diagnosis (uvsym, beyond the paper)
 
@@ -265,5 +265,5 @@ proportional fault):
 Every fault isolated by {_fmt(d["isolation_time_s"], 3)} s; cross-track RMS {_fmt(d["cross_track_rms_m"], 3)} m,
 miss at the dock {_fmt(d["dock_miss_m"], 3)} m. Its decision log (`--events events.json` writes it):
 
-{markdown_table(["t (s)", "event", "actuator", "kind", "value"], events)}
+{markdown_table(["t (s)", "event", "target", "kind", "value"], events)}
 """

@@ -1,8 +1,10 @@
 """Per-run metrics of a campaign: the truth from the scenario, the diagnosis from the event log.
 
-Events are dicts ``{"t": s, "event": "detected" | "isolated" | "identified" | "cleared" |
-"ambiguous" | "unexcited", "actuator": label or None, "kind": kind or None, "value": number or
-None}`` (for "ambiguous" the actuator is the candidates joined by "|").
+Events are the dicts of :mod:`uvsym.diagnosis.events` (``t``, ``event``, ``target``, ``kind``,
+``value``, ``detector``). The generic columns judge every event of the run together (any detector);
+a scenario with detectors also gets, per detector D, the columns ``D:<metric>`` of
+:data:`DETECTOR_COLUMNS` judged on D's events alone, so detectors in one loop are compared on the
+same runs.
 
 The run's fault is its earliest (actuator faults before sensor faults at equal onsets); sensor
 noise acting for the whole run is the sensors' specification, not a fault (as for the diagnosis,
@@ -18,30 +20,50 @@ import math
 
 import numpy as np
 
-__all__ = ["ALARMS", "METRIC_COLUMNS", "truth", "event_metrics", "run_metrics"]
+from uvsym.diagnosis.events import ALARMS
 
-ALARMS = ("detected", "isolated", "identified")
+__all__ = ["ALARMS", "DETECTOR_COLUMNS", "METRIC_COLUMNS", "truth", "event_metrics", "run_metrics", "signal_labels",
+           "detector_names"]
+
+DIAGNOSIS = "diagnosis"  # the detector name of a vehicle scenario's [diagnosis]
+# the columns each detector of a scenario gets, as D:<column>
+DETECTOR_COLUMNS = ("detected", "detection_delay_s", "isolated_target", "isolation_delay_s", "identified_value",
+                    "size_error_rel", "false_alarms", "ambiguous")
 # every generic column a run gets, with its type (the run's grid fields and the hook's columns follow)
 METRIC_COLUMNS = {
     "run_id": "string", "case": "string", "draw": "int64", "status": "string", "error": "string",
     "n_faults": "int64", "true_actuator": "string", "true_sensor": "string", "true_kind": "string",
     "true_value": "float64", "onset_s": "float64", "end_s": "float64",
-    "events": "int64", "detected": "bool", "detection_delay_s": "float64", "isolated_actuator": "string",
-    "isolated_kind": "string", "isolated_actuators": "string",
+    "events": "int64", "detected": "bool", "detection_delay_s": "float64", "isolated_target": "string",
+    "isolated_kind": "string", "isolated_targets": "string",
     "isolation_delay_s": "float64", "identified_value": "float64", "size_error_rel": "float64",
     "false_alarms": "int64", "ambiguous": "bool", "unexcited": "bool", "path_error_rms_m": "float64",
-    "wall_s": "float64",
+    "duration_s": "float64", "wall_s": "float64",
 }
+
+
+def signal_labels(scenario) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(input labels, output labels) that a scenario's actuator and sensor faults index: a plant's
+    inputs and outputs, or a vehicle's inputs and (measured) states."""
+    if hasattr(scenario, "plant"):
+        return scenario.input_labels, scenario.output_labels
+    return scenario.model.input_labels, scenario.model.state_labels
+
+
+def detector_names(scenario) -> tuple[str, ...]:
+    """The names of the scenario's detectors (a vehicle's continuous diagnosis is ``diagnosis``)."""
+    if hasattr(scenario, "detectors"):
+        return tuple(d.name for d in scenario.detectors)
+    return (DIAGNOSIS,) if getattr(scenario, "diagnosis", None) is not None else ()
 
 
 def truth(scenario) -> dict:
     """n_faults (whole-run sensor noise not counted: module docstring) and the run's fault:
     true_actuator or true_sensor (label), true_kind, true_value, onset_s and end_s (None when it
     lasts the run); None throughout without a fault."""
-    model = scenario.model
-    faults = [(f.profile.onset, 0, i, model.input_labels[f.actuator], None, f)
-              for i, f in enumerate(scenario.actuator_faults)]
-    faults += [(f.profile.onset, 1, i, None, model.state_labels[f.channel], f)
+    inputs, outputs = signal_labels(scenario)
+    faults = [(f.profile.onset, 0, i, inputs[f.actuator], None, f) for i, f in enumerate(scenario.actuator_faults)]
+    faults += [(f.profile.onset, 1, i, None, outputs[f.channel], f)
                for i, f in enumerate(scenario.sensor_faults)
                if not (f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end))]
     row = {"n_faults": len(faults), "true_actuator": None, "true_sensor": None, "true_kind": None,
@@ -59,9 +81,9 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     """Diagnosis metrics of one run from its events and :func:`truth`'s row.
 
     detected / detection_delay_s: a "detected" event in the fault's window, the first one's time
-    after the onset (s); isolated_actuator / isolated_kind: the last "isolated" decision not
+    after the onset (s); isolated_target / isolated_kind: the last "isolated" decision not
     cleared by the end of the run (a "cleared" naming its actuator, or none, clears it), and
-    isolated_actuators: every actuator isolated and not cleared then, in the order of isolation,
+    isolated_targets: every actuator isolated and not cleared then, in the order of isolation,
     joined by "|";
     isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
     identified_value: the last "identified" value in the window for it (or naming none);
@@ -80,18 +102,18 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         return onset is not None and onset <= e["t"] <= closed
 
     detections = [e for e in events if e["event"] == "detected" and in_window(e)]
-    isolations = [e for e in events if e["event"] == "isolated" and in_window(e) and e.get("actuator") == target]
+    isolations = [e for e in events if e["event"] == "isolated" and in_window(e) and e.get("target") == target]
     identified = [e for e in events if e["event"] == "identified" and in_window(e)
-                  and e.get("actuator") in (target, None) and e.get("value") is not None]
+                  and e.get("target") in (target, None) and e.get("value") is not None]
     standing: dict = {}  # actuator -> its isolation not cleared since (a diagnosis may hold several)
     for e in events:
         if e["event"] == "isolated":
-            standing.pop(e.get("actuator"), None)
-            standing[e.get("actuator")] = e
+            standing.pop(e.get("target"), None)
+            standing[e.get("target")] = e
         elif e["event"] == "cleared":
-            if e.get("actuator") is None:
+            if e.get("target") is None:
                 standing.clear()
-            standing.pop(e.get("actuator"), None)
+            standing.pop(e.get("target"), None)
     decision = list(standing.values())[-1] if standing else None
     value = float(identified[-1]["value"]) if identified else None
     true_value = true["true_value"]
@@ -99,24 +121,32 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "events": len(events),
         "detected": bool(detections),
         "detection_delay_s": detections[0]["t"] - onset if detections else None,
-        "isolated_actuator": None if decision is None else decision.get("actuator"),
+        "isolated_target": None if decision is None else decision.get("target"),
         "isolated_kind": None if decision is None else decision.get("kind"),
-        "isolated_actuators": "|".join(str(a) for a in standing) or None,
+        "isolated_targets": "|".join(str(a) for a in standing) or None,
         "isolation_delay_s": isolations[0]["t"] - onset if isolations else None,
         "identified_value": value,
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
         "false_alarms": sum(e["event"] in ALARMS and not in_window(e) for e in events),
         "ambiguous": any(e["event"] == "ambiguous" for e in events),
-        "unexcited": any(e["event"] == "unexcited" and e.get("actuator") in (target, None) for e in events),
+        "unexcited": any(e["event"] == "unexcited" and e.get("target") in (target, None) for e in events),
     }
 
 
 def run_metrics(scenario, result, events: list[dict]) -> dict:
-    """:func:`truth`, :func:`event_metrics` and path_error_rms_m (RMS of the reference's cross-track
-    error over the run, m; None when the result has none)."""
+    """:func:`truth`, :func:`event_metrics`, duration_s (simulated s), path_error_rms_m (RMS of the
+    reference's cross-track error over the run, m; None when the result has none) and, per
+    detector D, ``D:<metric>`` for each of :data:`DETECTOR_COLUMNS` (module docstring)."""
     true = truth(scenario)
     reference = result.signals.get("reference")
     rms = None
     if reference is not None and "cross_track" in reference.labels:
         rms = float(np.sqrt(np.mean(np.square(reference["cross_track"]))))
-    return true | event_metrics(true, events) | {"path_error_rms_m": rms}
+    row = true | event_metrics(true, events) | {"path_error_rms_m": rms,
+                                                "duration_s": float(result.t[-1] - result.t[0])}
+    names = detector_names(scenario)
+    if len(names) > 1 or hasattr(scenario, "detectors"):
+        for name in names:
+            own = event_metrics(true, [e for e in events if e.get("detector") == name])
+            row |= {f"{name}:{column}": own[column] for column in DETECTOR_COLUMNS}
+    return row

@@ -14,8 +14,9 @@ file order) and ``[case.monte_carlo]`` (``runs`` draws per grid point from the m
 dotted path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}``
 (both ends included) or ``{choice = [...]}``). Paths follow :mod:`uvsym.campaign.dotted`.
 
-Every run's scenario is parsed by :func:`~uvsym.sim.scenario.parse_scenario` when the campaign is
-loaded, so a bad field fails before anything runs. A run's id hashes its case name and its whole
+A case's scenario is a vehicle scenario or a scenario over any plant (``plant = ...``,
+:mod:`uvsym.sim.system_scenario`); every run's scenario is parsed when the campaign is loaded, so a
+bad field fails before anything runs. A run's id hashes its case name and its whole
 scenario table: the key a resumed campaign skips finished runs by.
 """
 
@@ -36,13 +37,15 @@ from uvsym.campaign.dotted import flatten, parse_path, set_path
 from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError
 from uvsym.sim.fields import Fields
 from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
+from uvsym.sim.system_scenario import is_system_scenario, parse_system_scenario
 
-__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS"]
+__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "parse_any_scenario", "DISTRIBUTIONS",
+           "EXECUTORS"]
 
 DISTRIBUTIONS = ("uniform", "normal", "integers", "choice")
 EXECUTORS = ("local", "dask")
 # field paths whose sweep is a setting of the diagnosis rather than of the mission: ROC groups by default
-_SETTING_ROOTS = ("diagnosis", "observers")
+_SETTING_ROOTS = ("diagnosis", "observers", "detectors", "blocks")
 
 
 @dataclass(frozen=True)
@@ -192,8 +195,8 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
             from uvsym.derivation import study_scenarios
 
             study = study_scenarios().get(source)
-            kind = (f" ({source!r} is a scenario of the {study[0]} study: campaigns take vehicle scenarios)"
-                    if study else "")
+            kind = (f" ({source!r} is a scenario of the {study[0]} study, whose experiments do not run in campaigns "
+                    "yet)" if study else "")
             raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}{kind}; "
                                 f"shipped: {', '.join(shipped)}")
         path = shipped[source]
@@ -203,7 +206,9 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
         raise CampaignError(f"{fields.path}.scenario: {exc}") from None
     if "study" in table:
         raise CampaignError(f"{fields.path}.scenario: {path.name} is a derivation's scenario (study = ...); "
-                            "campaigns run vehicle scenarios")
+                            "campaigns run vehicle scenarios and scenarios over a plant (plant = ...)")
+    if is_system_scenario(table) and ":" in str(table["plant"]):
+        table.setdefault("plant_path", str(path.parent.resolve()))  # the plant's module, beside its scenario
     return table, path.stem
 
 
@@ -340,9 +345,16 @@ def _expand(spec: dict) -> list[Run]:
     return runs
 
 
+def parse_any_scenario(table: dict, default_name: str = "scenario"):
+    """The validated scenario of a campaign run's table: over a plant (``plant = ...``) or a vehicle."""
+    if is_system_scenario(table):
+        return parse_system_scenario(table, default_name=default_name)
+    return parse_scenario(table, default_name=default_name)
+
+
 def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str) -> Run:
     try:
-        parse_scenario(table, default_name=scenario_name)
+        parse_any_scenario(table, default_name=scenario_name)
     except UvsymError as exc:
         raise CampaignError(f"case {case!r}, run {_describe(fields)}"
                             + ("" if draw is None else f", draw {draw}") + f": {exc}") from None

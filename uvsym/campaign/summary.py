@@ -4,7 +4,14 @@ Rates are fractions of the runs that finished without error: detection and isola
 the runs with a fault, the false-alarm rate (runs with at least one false alarm) over all. The
 confusion matrix counts true fault target (actuator or sensor; "none" without a fault) against
 the final isolated actuator ("none" without one). ROC: one point (false-alarm rate, detection
-probability) per value of the ``roc_by`` fields, e.g. a swept diagnosis threshold.
+probability) per value of the ``roc_by`` fields, e.g. a swept diagnosis threshold, for all
+detectors together and for each detector.
+
+Per detector D (the runs' ``D:<metric>`` columns): detection probability and missed detections
+over the runs with a fault, median detection and isolation delays (s), correct isolation (the
+true target isolated within the fault's window), median identification error, and false alarms per
+hour of healthy time (the whole run without a fault, the time before the onset with one); the
+CPU time per simulated hour is the whole run's (simulation and every detector).
 """
 
 from __future__ import annotations
@@ -17,9 +24,10 @@ import numpy as np
 from uvsym.report.html import write_html
 from uvsym.report.markdown import markdown_table, write_json
 
-__all__ = ["summarize", "write_report"]
+__all__ = ["summarize", "write_report", "detector_names", "detector_rates"]
 
-_NO_EVENTS = ("\nNo run logged a diagnosis event (a scenario needs a [diagnosis] table for its event log): the "
+_NO_EVENTS = ("\nNo run logged a diagnosis event (a scenario needs a [diagnosis] table or [[detectors]] for its event "
+              "log): the "
               "rates above count no detection, isolation or alarm.\n")
 _DISTRIBUTIONS = ("detection_delay_s", "isolation_delay_s", "size_error_rel", "path_error_rms_m", "wall_s")
 
@@ -47,10 +55,40 @@ def _rates(rows: list[dict]) -> dict:
     return {"runs": len(rows), "ok": len(ok), "errors": len(rows) - len(ok), "fault_runs": len(faulty),
             "no_fault_runs": len(ok) - len(faulty), "runs_with_events": sum(bool(r["events"]) for r in ok),
             "detection_rate": _rate(faulty, lambda r: r["detected"]),
-            "isolation_rate": _rate(faulty, lambda r: r["isolated_actuator"] == _target(r)),
+            "isolation_rate": _rate(faulty, lambda r: r["isolated_target"] == _target(r)),
             "false_alarm_rate": _rate(ok, lambda r: r["false_alarms"]),
             "ambiguous_rate": _rate(ok, lambda r: r["ambiguous"]),
             "unexcited_rate": _rate(ok, lambda r: r["unexcited"])}
+
+
+def detector_names(rows: list[dict]) -> list[str]:
+    """The detectors whose columns (``D:detected``) the rows hold, in first-seen order."""
+    return list(dict.fromkeys(key[:-len(":detected")] for row in rows for key in row if key.endswith(":detected")))
+
+
+def _median(values) -> float | None:
+    data = [v for v in values if v is not None and math.isfinite(v)]
+    return float(np.median(data)) if data else None
+
+
+def detector_rates(rows: list[dict], name: str) -> dict:
+    """The per-detector figures of the module docstring for detector ``name`` over ``rows``."""
+    ok = [r for r in rows if r["status"] == "ok" and f"{name}:detected" in r]
+    faulty = [r for r in ok if r["n_faults"]]
+    healthy_s = sum(r["onset_s"] if r["n_faults"] and r["onset_s"] is not None else (r.get("duration_s") or 0.0)
+                    for r in ok)
+    simulated_s = sum(r.get("duration_s") or 0.0 for r in ok)
+    alarms = sum(r[f"{name}:false_alarms"] or 0 for r in ok)
+    return {"runs": len(ok), "fault_runs": len(faulty),
+            "detection_probability": _rate(faulty, lambda r: r[f"{name}:detected"]),
+            "missed_detections": sum(not r[f"{name}:detected"] for r in faulty),
+            "median_detection_delay_s": _median(r[f"{name}:detection_delay_s"] for r in faulty),
+            "median_isolation_delay_s": _median(r[f"{name}:isolation_delay_s"] for r in faulty),
+            "correct_isolation": _rate(faulty, lambda r: r[f"{name}:isolation_delay_s"] is not None),
+            "median_size_error_rel": _median(r[f"{name}:size_error_rel"] for r in faulty),
+            "false_alarms": alarms, "healthy_hours": healthy_s / 3600.0,
+            "false_alarms_per_hour": alarms / (healthy_s / 3600.0) if healthy_s > 0 else None,
+            "cpu_s_per_simulated_hour": (sum(r["wall_s"] for r in ok) / simulated_s * 3600.0) if simulated_s else None}
 
 
 def summarize(rows: list[dict], name: str, total_runs: int, roc_by: tuple[str, ...] = ()) -> dict:
@@ -59,21 +97,32 @@ def summarize(rows: list[dict], name: str, total_runs: int, roc_by: tuple[str, .
     confusion: dict[str, dict[str, int]] = {}
     for row in ok:
         cell = confusion.setdefault(_target(row), {})
-        isolated = row["isolated_actuator"] or "none"
+        isolated = row["isolated_target"] or "none"
         cell[isolated] = cell.get(isolated, 0) + 1
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
         groups.setdefault(tuple(row.get(c) for c in roc_by), []).append(row)
+    detectors = detector_names(rows)
     roc = [{"group": dict(zip(roc_by, key)), "runs": rates["runs"], "detection_probability": rates["detection_rate"],
-            "false_alarm_rate": rates["false_alarm_rate"]}
-           for key, rates in ((key, _rates(members)) for key, members in groups.items())]
+            "false_alarm_rate": rates["false_alarm_rate"],
+            "detectors": {d: _detector_roc(members, d) for d in detectors}}
+           for key, rates, members in ((key, _rates(members), members) for key, members in groups.items())]
     cases: dict[str, list[dict]] = {}
     for row in rows:
         cases.setdefault(row["case"], []).append(row)
     return {"campaign": name, "total_runs": total_runs, **_rates(rows),
             "confusion": {true: dict(sorted(cell.items())) for true, cell in sorted(confusion.items())},
             **{column: _quantiles(r[column] for r in ok) for column in _DISTRIBUTIONS},
-            "roc_by": list(roc_by), "roc": roc, "cases": {case: _rates(members) for case, members in cases.items()}}
+            "roc_by": list(roc_by), "roc": roc, "cases": {case: _rates(members) for case, members in cases.items()},
+            "detectors": {d: detector_rates(rows, d) for d in detectors}}
+
+
+def _detector_roc(rows: list[dict], name: str) -> dict:
+    """One ROC point of detector ``name``: detection probability over the runs with a fault, and the
+    fraction of runs with a false alarm."""
+    ok = [r for r in rows if r["status"] == "ok" and f"{name}:detected" in r]
+    return {"detection_probability": _rate([r for r in ok if r["n_faults"]], lambda r: r[f"{name}:detected"]),
+            "false_alarm_rate": _rate(ok, lambda r: r[f"{name}:false_alarms"])}
 
 
 def _shown(value) -> str:
@@ -98,7 +147,7 @@ def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
                     color="white" if count > counts.max() / 2 else "black")
         ax.set_xticks(range(len(labels_isolated)), labels_isolated)
         ax.set_yticks(range(len(labels_true)), labels_true)
-    ax.set_xlabel("isolated actuator")
+    ax.set_xlabel("isolated target")
     ax.set_ylabel("true fault")
     ax.set_title("confusion matrix (runs)")
     fig.tight_layout()
@@ -108,7 +157,14 @@ def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
     points = sorted((p["false_alarm_rate"], p["detection_probability"], ", ".join(map(_label, p["group"].values())))
                     for p in summary["roc"]
                     if p["detection_probability"] is not None and p["false_alarm_rate"] is not None)
-    ax.plot([p[0] for p in points], [p[1] for p in points], "o-")
+    ax.plot([p[0] for p in points], [p[1] for p in points], "o-", label="all detectors")
+    for detector in summary["detectors"]:
+        own = sorted((p["detectors"][detector]["false_alarm_rate"], p["detectors"][detector]["detection_probability"])
+                     for p in summary["roc"] if p["detectors"][detector]["detection_probability"] is not None
+                     and p["detectors"][detector]["false_alarm_rate"] is not None)
+        ax.plot([q[0] for q in own], [q[1] for q in own], "s--", label=detector)
+    if summary["detectors"]:
+        ax.legend(fontsize=8, loc="lower right")
     for x, y, label in points:
         ax.annotate(label, (x, y), xytext=(-4 if x > 0.5 else 4, 4), textcoords="offset points", fontsize=8,
                     ha="right" if x > 0.5 else "left")
@@ -154,6 +210,14 @@ def write_report(folder, summary: dict, rows: list[dict], description: str = "")
     cases = markdown_table(["case", "runs", "ok", "errors", "detection rate", "false-alarm rate"],
                            [[case, c["runs"], c["ok"], c["errors"], _shown(c["detection_rate"]),
                              _shown(c["false_alarm_rate"])] for case, c in summary["cases"].items()])
+    per_detector = markdown_table(
+        ["detector", "runs", "detection probability", "missed", "median delay (s)", "correct isolation",
+         "median isolation delay (s)", "false alarms per hour", "healthy hours", "CPU s per simulated hour"],
+        [[d, f["runs"], _shown(f["detection_probability"]), f["missed_detections"],
+          _shown(f["median_detection_delay_s"]), _shown(f["correct_isolation"]), _shown(f["median_isolation_delay_s"]),
+          _shown(f["false_alarms_per_hour"]), _shown(f["healthy_hours"]), _shown(f["cpu_s_per_simulated_hour"])]
+         for d, f in summary["detectors"].items()])
+    detectors = f"## Detectors side by side\n\n{per_detector}\n" if summary["detectors"] else ""
     errors = [r for r in rows if r["status"] != "ok"]
     error_list = "\n".join(f"- `{r['run_id']}` ({r['case']}): {r['error']}" for r in errors[:20]) or "- none"
     if len(errors) > 20:
@@ -169,7 +233,7 @@ def write_report(folder, summary: dict, rows: list[dict], description: str = "")
 
 {markdown_table(["rate", "value"], rates)}
 {"" if summary["runs_with_events"] else _NO_EVENTS}
-
+{detectors}
 ## Cases
 
 {cases}

@@ -44,23 +44,25 @@ def _base(run: Run) -> dict:
 
 def failure_row(run: Run, message: str) -> dict:
     """The error row of a run that gave no row of its own (e.g. its worker process died)."""
-    from uvsym.sim.scenario import parse_scenario
+    from uvsym.campaign.spec import parse_any_scenario
 
-    return _base(run) | truth(parse_scenario(run.scenario)) | {"status": "error", "error": message}
+    return _base(run) | truth(parse_any_scenario(run.scenario)) | {"status": "error", "error": message}
 
 
 def execute(run: Run, settings: Settings, hook=None) -> dict:
     """Simulate ``run`` and return its row: run_id, case, draw, its fields, status, error, the
     metrics of :func:`uvsym.campaign.metrics.run_metrics`, the hook's columns and wall_s (s)."""
-    from uvsym.sim.scenario import parse_scenario
+    from uvsym.campaign.spec import parse_any_scenario
     from uvsym.sim.simulation import simulate_scenario
+    from uvsym.sim.system_scenario import SystemScenario, simulate_system_scenario
 
     started = time.perf_counter()
     row = _base(run)
     try:
-        scenario = parse_scenario(run.scenario)
+        scenario = parse_any_scenario(run.scenario)
         row |= truth(scenario)
-        result = simulate_scenario(scenario, **dict(settings.simulation))
+        simulate = simulate_system_scenario if isinstance(scenario, SystemScenario) else simulate_scenario
+        result = simulate(scenario, **dict(settings.simulation))
         events = list(getattr(result, "events", None) or [])
         row |= run_metrics(scenario, result, events)
         if hook is not None:

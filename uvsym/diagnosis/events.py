@@ -1,9 +1,16 @@
 """The decision log of a diagnosis: one record per state change, written as JSON.
 
-Schema (stable): a JSON list of ``{"t": s, "event": one of EVENTS, "actuator": label or null,
-"kind": fault kind or null, "value": number or null}``. ``actuator`` names one actuator, or for
-``ambiguous`` the candidates joined by ``|``; ``value`` is a fault size in the kind's unit
-(``-`` for kinds that scale the command, else the input's unit).
+Schema (stable), one vocabulary for every detector: a JSON list of ``{"t": s, "event": one of
+EVENTS, "target": signal name or null, "kind": fault kind or null, "value": number or null,
+"detector": the deciding block's name or null}``. ``target`` names the input (an actuator) or the
+output (a sensor) the decision is about, or for ``ambiguous`` the candidates joined by ``|``;
+``value`` is a fault size in the kind's unit (``-`` for kinds that scale a signal, else the
+signal's unit).
+
+Events: ``detected`` (something is wrong), ``isolated`` (it is this target), ``identified`` (its
+size), ``cleared`` (the fault, or with no target every fault, is gone), ``ambiguous`` (the data
+cannot tell the candidates apart), ``unexcited`` (the target is not excited enough to be judged),
+``unexplained`` (no hypothesis of the detector fits the data).
 """
 
 from __future__ import annotations
@@ -13,22 +20,28 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from uvsym.errors import PathError
+from uvsym.errors import DiagnosisError, PathError
 
-__all__ = ["EVENTS", "Event", "write_events"]
+__all__ = ["ALARMS", "EVENTS", "Event", "write_events"]
 
-EVENTS = ("detected", "isolated", "identified", "cleared", "ambiguous", "unexcited")
+EVENTS = ("detected", "isolated", "identified", "cleared", "ambiguous", "unexcited", "unexplained")
+ALARMS = ("detected", "isolated", "identified")  # the events that say a fault is present
 
 
 @dataclass(frozen=True)
 class Event:
-    """t (s), event (one of EVENTS), actuator label, fault kind, value (see the module docstring)."""
+    """t (s), event (one of EVENTS), target signal, fault kind, value, detector (module docstring)."""
 
     t: float
     event: str
-    actuator: str | None = None
+    target: str | None = None
     kind: str | None = None
     value: float | None = None
+    detector: str | None = None
+
+    def __post_init__(self):
+        if self.event not in EVENTS:
+            raise DiagnosisError(f"event {self.event!r} is not one of {', '.join(EVENTS)}")
 
     def as_dict(self) -> dict:
         record = asdict(self)

@@ -42,6 +42,7 @@ from uvsym.observers.identification import ActuatorFaultEstimate, configuration_
 
 __all__ = ["ActuatorDiagnosis", "residual_noise"]
 
+DETECTOR = "diagnosis"  # the name its events carry
 _GAUSS_NEWTON_STEPS = 8  # at most, when a decided fault is sized
 
 
@@ -173,7 +174,7 @@ class ActuatorDiagnosis:
 
     def _log(self, k: int, event: str, actuator: str | None, kind: str | None = None, value=None) -> None:
         t = round(float(self._t[k]), 9)  # the sample time, without the float noise of k * dt
-        self.events.append(Event(t, event, actuator, kind, None if value is None else float(value)))
+        self.events.append(Event(t, event, actuator, kind, None if value is None else float(value), DETECTOR))
 
     def _decide(self, k: int) -> None:
         rows = np.arange(k - self.W + 1, k + 1)

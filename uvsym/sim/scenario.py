@@ -186,7 +186,8 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
 
     top.describe("controller", "table", "the loops and the path")
     controller = _controller(top.table("controller"), model)
-    actuator_faults, sensor_faults = _faults(top.tables("faults"), model, duration)
+    actuator_faults, sensor_faults = fault_tables(top.tables("faults"), model.input_labels, model.state_labels,
+                                                  duration)
     observers = _observers(top.tables("observers"), model)
     diagnosis = _diagnosis(top.table("diagnosis"), model, observers, sensor_faults, duration, step)
     top.done()
@@ -262,30 +263,35 @@ def _profile(fields: _Fields) -> Profile:
     return Profile(**kwargs)
 
 
-def _faults(items: list[_Fields], model: Model, duration: float):
-    """The actuator and sensor faults; ScenarioError naming the field of one that is malformed or
-    can never act (onset outside [0, duration), a value that changes nothing, a negative factor)."""
+def fault_tables(items: list[_Fields], inputs: tuple[str, ...], outputs: tuple[str, ...], duration: float,
+                 owner: str = "the vehicle"):
+    """(actuator faults, sensor faults) of ``[[faults]]`` tables: ``actuator`` names one of ``inputs``,
+    ``sensor`` one of ``outputs``. ScenarioError naming the field of one that is malformed or can never
+    act (onset outside [0, duration), a value that changes nothing, a negative factor)."""
     actuator, sensor = [], []
     for fields in items:
-        fields.describe("actuator", "string", "an input label of the vehicle (an actuator fault)", "one of the two")
-        fields.describe("sensor", "string", "a state label of the vehicle (a sensor fault)", "one of the two")
+        fields.describe("actuator", "string", f"an input of {owner} (an actuator fault)", "one of the two")
+        fields.describe("sensor", "string", f"a measured signal of {owner} (a sensor fault)", "one of the two")
         fields.describe("kind", "string", f"with actuator: {', '.join(ACTUATOR_KINDS)}; with sensor: "
                                           f"{', '.join(SENSOR_KINDS)}")
         try:
             if fields.has("actuator"):
-                label = fields.text("actuator", choices=model.input_labels)
+                label = fields.text("actuator", choices=inputs)
                 kind = fields.text("kind", choices=tuple(ACTUATOR_KINDS))
-                fault = ActuatorFault(model.input_labels.index(label), kind, fields.number("value"), _profile(fields))
+                fault = ActuatorFault(inputs.index(label), kind, fields.number("value"), _profile(fields))
                 _check_actuator_value(fields, fault)
                 actuator.append(fault)
             elif fields.has("sensor"):
-                label = fields.text("sensor", choices=model.state_labels)
+                label = fields.text("sensor", choices=outputs)
                 kind = fields.text("kind", choices=tuple(SENSOR_KINDS))
-                fault = SensorFault(model.state_labels.index(label), kind, fields.number("value", 0.0),
-                                    _profile(fields))
+                value = fields.number("value", 0.0 if kind == "stuck" else None)
+                fault = SensorFault(outputs.index(label), kind, value, _profile(fields))
+                if kind != "stuck" and fault.value == 0.0:
+                    raise ScenarioError(f"{fields.path}.value: a {kind} fault of 0 changes nothing")
                 sensor.append(fault)
             else:
-                raise ScenarioError(f"{fields.path}: give either actuator = <input label> or sensor = <state label>")
+                raise ScenarioError(f"{fields.path}: give either actuator = <input of {owner}> or sensor = "
+                                    f"<measured signal of {owner}>")
         except FaultError as exc:
             raise ScenarioError(f"{fields.path}.{_fault_field(str(exc))}: {exc}") from None
         if not 0.0 <= fault.profile.onset < duration:

@@ -12,7 +12,7 @@ from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_clo
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
-__all__ = ["simulate_system", "initial_state"]
+__all__ = ["simulate_system", "initial_state", "loop_inputs", "run_wired"]
 
 
 def initial_state(loop: WiredLoop, x0, w0: np.ndarray) -> np.ndarray:
@@ -66,16 +66,36 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
                                   f"end of the run ({duration:g} s): the fault would never act")
     loop = interconnect(plant, blocks, dt=dt, actuator_faults=tuple(actuator_faults),
                         sensor_faults=tuple(sensor_faults), substitutions=substitutions, substeps=substeps, p=p)
-    check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
-    W = sample_inputs(loop.n_w, N, dt, plant.y.size, seed)  # one row per sample: [t, noise, d, switches]
-    W[:, loop.env_columns] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
+    W = loop_inputs(loop, N, d, seed)
     z0 = initial_state(loop, x0, W[0])
+    return run_wired(loop, z0, W, method=method, supervisor=supervisor, options=options, compiled=compiled,
+                     progress=progress, duration=duration, seed=seed, actuator_faults=actuator_faults,
+                     sensor_faults=sensor_faults,
+                     substitutions=substitutions)
+
+
+def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0) -> np.ndarray:
+    """W (N + 1, n_w) of a wired loop: times, seeded noise draws, disturbances d (constant (n_d,) or one
+    row per sample; default 0), substitution switches off. SimulationError when it cannot be held."""
+    plant = loop.plant
+    check_memory(memory_needed(N + 1, loop), f"{N * loop.dt:g} s at step {loop.dt:g} s ({N + 1} samples)")
+    W = sample_inputs(loop.n_w, N, loop.dt, plant.y.size, seed)  # one row per sample: [t, noise, d, switches]
+    W[:, loop.env_columns] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
+    return W
+
+
+def run_wired(loop: WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
+              supervisor: Supervisor | None = None, options: dict | None = None, compiled: bool = True,
+              progress=None, duration: float, seed: int = 0, actuator_faults=(), sensor_faults=(),
+              substitutions=None) -> SimResult:
+    """Run a wired loop from z0 over the rows of W (:func:`loop_inputs`); the result of :func:`simulate_system`
+    (the faults and substitutions given only describe the loop's own in the result's meta)."""
+    plant = loop.plant
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
                                      compiled=compiled, progress=progress)
-    meta = {"plant": plant.name, "method": method, "dt_s": dt, "duration_s": duration, "substeps": substeps,
-            "seed": seed, "blocks": [b.name for b in loop.blocks], "order": list(loop.order),
-            "substitutions": dict(substitutions or {}),
+    meta = {"plant": plant.name, "method": method, "dt_s": loop.dt, "duration_s": duration,
+            "substeps": loop.substeps, "seed": seed, "blocks": [b.name for b in loop.blocks],
+            "order": list(loop.order), "substitutions": dict(substitutions or {}),
             "actuator_faults": [fault_summary(f, plant.u.names[f.actuator]) for f in actuator_faults],
             "sensor_faults": [fault_summary(f, plant.y.names[f.channel]) for f in sensor_faults], **timing}
     return SimResult(result.t, result.signals, meta)
-

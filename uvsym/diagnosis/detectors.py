@@ -1,0 +1,143 @@
+"""Detectors: decision blocks that read a finished record and publish into the one event log.
+
+A detector has a ``name`` and ``decide(result) -> list[Event]`` (:mod:`uvsym.diagnosis.events`);
+it reads the signals it names from the :class:`~uvsym.sim.result.SimResult` (``<group>.<label>``,
+e.g. ``obs.r_omega_m``) and decides on every sample, as it would in the loop.
+
+:class:`ResidualThreshold` -- residuals r_i (m of them) against thresholds ``c_i = z sigma_i``
+with ``z = Phi^-1(1 - alpha / (2 m))`` and ``alpha = F dt / 3600``: under the stated noise model
+(r Gaussian, zero mean, standard deviations sigma, from the loop's sensor noise by
+:func:`~uvsym.diagnosis.calibration.residual_covariance` or given) a healthy sample exceeds some
+threshold with probability at most alpha (Bonferroni), so the expected number of samples that
+exceed, and hence of alarms, is at most F per hour (F: the designed false alarms per hour), for
+correlated residuals too. ``detected`` once ``confirm`` samples in a row exceed, and ``isolated`` on the
+residual's target with the largest ``|r_i| / c_i`` there (where targets are given); ``cleared`` once ``release`` samples
+in a row do not (hysteresis: no alarm stays latched after its evidence is gone). Samples before
+``ignore_before`` s (the estimator's start-up) are not judged.
+
+:class:`DoubleCriterion` -- the LMS-FIR monitor's own decision (Zhu et al., Sec. 3.2; published
+as ``fault_<y>``): ``detected`` and ``isolated`` on sensor y when its fault flag rises,
+``cleared`` when it falls.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import norm
+
+from uvsym.diagnosis.events import Event
+from uvsym.errors import DiagnosisError
+
+__all__ = ["ResidualThreshold", "DoubleCriterion", "threshold_factor", "read_signal"]
+
+
+def read_signal(result, name: str) -> np.ndarray:
+    """(N,) the logged signal ``<group>.<label>`` of a SimResult; DiagnosisError naming it when absent."""
+    group, _, label = name.partition(".")
+    if group not in result.signals or label not in result.signals[group].labels:
+        known = [f"{g}.{lab}" for g, s in result.signals.items() for lab in s.labels]
+        raise DiagnosisError(f"signal {name!r} is not in the result; logged: {', '.join(known)}")
+    return np.asarray(result[group][label], dtype=float)
+
+
+def threshold_factor(false_alarms_per_hour: float, dt: float, channels: int) -> float:
+    """z of ``c = z sigma`` (module docstring): the two-sided Gaussian quantile of ``alpha / (2 m)``,
+    ``alpha = F dt / 3600``, the per-sample false-alarm probability that allows F alarms per hour."""
+    alpha = false_alarms_per_hour * dt / 3600.0
+    if not 0.0 < alpha < 1.0:
+        raise DiagnosisError(f"false_alarms_per_hour = {false_alarms_per_hour:g} at dt = {dt:g} s gives a per-sample "
+                             f"probability of {alpha:g}, outside (0, 1)")
+    return float(norm.isf(alpha / (2 * channels)))
+
+
+@dataclass(frozen=True)
+class ResidualThreshold:
+    """Threshold test on residuals (module docstring). residuals: m signal names; sigma: (m,) their
+    standard deviations (residuals' units); targets: the signal each residual points to (an input
+    or output of the plant) or None; dt: sample period (s)."""
+
+    name: str
+    residuals: tuple[str, ...]
+    sigma: np.ndarray
+    dt: float
+    false_alarms_per_hour: float = 1.0
+    confirm: int = 3
+    release: int = 20
+    ignore_before: float = 0.0
+    targets: tuple[str | None, ...] = ()
+    thresholds: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        sigma = np.asarray(self.sigma, dtype=float).reshape(-1)
+        if sigma.shape != (len(self.residuals),) or not np.all(np.isfinite(sigma)) or np.any(sigma <= 0):
+            raise DiagnosisError(f"detector {self.name}: sigma must be {len(self.residuals)} positive finite standard "
+                                 f"deviations (one per residual), got {sigma.tolist()}")
+        for what in ("confirm", "release"):
+            value = getattr(self, what)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise DiagnosisError(f"detector {self.name}: {what} must be an integer >= 1 (samples), got {value!r}")
+        targets = self.targets or (None,) * len(self.residuals)
+        if len(targets) != len(self.residuals):
+            raise DiagnosisError(f"detector {self.name}: {len(targets)} targets for {len(self.residuals)} residuals")
+        object.__setattr__(self, "targets", tuple(targets))
+        object.__setattr__(self, "sigma", sigma)
+        z = threshold_factor(self.false_alarms_per_hour, self.dt, len(self.residuals))
+        object.__setattr__(self, "thresholds", z * sigma)
+
+    def decide(self, result) -> list[Event]:
+        """The detections and clearances of the record (module docstring)."""
+        t = np.asarray(result.t, dtype=float)
+        ratio = np.column_stack([np.abs(read_signal(result, r)) / c for r, c in zip(self.residuals, self.thresholds)])
+        ratio[t < self.ignore_before - 1e-9 * max(1.0, abs(self.ignore_before))] = 0.0
+        outside = ratio.max(axis=1) > 1.0
+        events, alarm, run_in, run_out = [], False, 0, 0
+        for k, over in enumerate(outside):
+            run_in, run_out = (run_in + 1, 0) if over else (0, run_out + 1)
+            if not alarm and run_in >= self.confirm:
+                alarm = True
+                target, time = self.targets[int(np.argmax(ratio[k]))], round(float(t[k]), 9)
+                events.append(Event(time, "detected", target, detector=self.name))
+                if target is not None:
+                    events.append(Event(time, "isolated", target, detector=self.name))
+            elif alarm and run_out >= self.release:
+                alarm = False
+                events.append(Event(round(float(t[k]), 9), "cleared", detector=self.name))
+        return events
+
+    def design(self) -> dict:
+        """What the decision rule is designed for: per-sample and per-hour false-alarm rates and thresholds."""
+        return {"detector": self.name, "rule": "|r_i| > z sigma_i", "residuals": list(self.residuals),
+                "sigma": self.sigma.tolist(), "thresholds": self.thresholds.tolist(),
+                "false_alarms_per_hour": self.false_alarms_per_hour,
+                "per_sample_probability": self.false_alarms_per_hour * self.dt / 3600.0,
+                "confirm_samples": self.confirm, "release_samples": self.release}
+
+
+@dataclass(frozen=True)
+class DoubleCriterion:
+    """The LMS monitor ``monitor``'s fault flag on ``sensor`` as events (module docstring)."""
+
+    name: str
+    monitor: str
+    sensor: str
+
+    def decide(self, result) -> list[Event]:
+        t = np.asarray(result.t, dtype=float)
+        flag = read_signal(result, f"{self.monitor}.fault_{self.sensor}") > 0.5
+        changes = np.flatnonzero(np.diff(np.concatenate([[False], flag]).astype(int)))
+        events = []
+        for k in changes:
+            time = round(float(t[k]), 9)
+            if flag[k]:
+                events += [Event(time, "detected", self.sensor, detector=self.name),
+                           Event(time, "isolated", self.sensor, detector=self.name)]
+            else:
+                events.append(Event(time, "cleared", self.sensor, detector=self.name))
+        return events
+
+    def design(self) -> dict:
+        return {"detector": self.name, "rule": "LMS double criterion (eps^2 > eps0 confirmed by R > r0)",
+                "monitor": self.monitor, "sensor": self.sensor}
+

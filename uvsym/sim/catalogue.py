@@ -1,0 +1,201 @@
+"""The blocks a scenario file can name: ``[[blocks]]`` tables turned into loop blocks.
+
+Each table has ``type`` (a key of :data:`BLOCKS`) and ``name`` (the block's name: the result group
+of what it publishes, and the prefix of its qualified signal names ``<name>.<signal>``), plus the
+design parameters of its type. Gains are designed from them here (an LQR from its weights, a
+Luenberger gain by LMI from a decay rate), never typed in the file, unless the file gives the
+gain itself. Units are SI, as everywhere in uvsym.
+
+===============  ==============================================================================
+type             fields (besides type and name)
+===============  ==============================================================================
+pid              measured, output (signal names), reference (number or signal name), kp, ki, kd,
+                 limits = [lo, hi]
+state_feedback   gain (m x n), reads (n names), publishes (m names), x_ref, u_ref
+lqr              q, r (weights: a list of the diagonal or a full matrix), reads (default: the
+                 plant's states), publishes (default: the plant's inputs)
+open_loop        times (s), values (one row per time), publishes, interpolation
+luenberger       decay (1/s, LMI design certified in exact arithmetic) or gain (n x n_y)
+ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
+lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
+                 hold, confirm (samples)
+===============  ==============================================================================
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uvsym.errors import ScenarioError, UvsymError
+from uvsym.sim.blocks import Block, observer_block
+from uvsym.sim.fields import Fields
+from uvsym.systems.signals import Signals
+from uvsym.systems.system import System
+
+__all__ = ["BLOCKS", "build_block"]
+
+
+def _matrix(fields: Fields, key: str, shape: tuple[int, int], default=None, *, diagonal: bool = True) -> np.ndarray:
+    """A (rows, cols) matrix: a full list of rows, or (square, ``diagonal``) a number or the diagonal."""
+    fields._record(key, "number, list or matrix", default, f"{shape[0]} x {shape[1]}" + (", or its diagonal"
+                                                                                          if diagonal else ""))
+    fields.used.add(key)
+    value = fields.data.get(key, default)
+    if value is None:
+        raise ScenarioError(f"{fields._name(key)}: required matrix is missing{fields._misspelt(key)}")
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{fields._name(key)}: expected numbers, got {value!r}") from None
+    if diagonal and shape[0] == shape[1] and array.ndim == 0:
+        array = np.full(shape[0], float(array))
+    if diagonal and shape[0] == shape[1] and array.shape == (shape[0],):
+        array = np.diag(array)
+    if array.shape != shape or not np.all(np.isfinite(array)):
+        raise ScenarioError(f"{fields._name(key)}: expected a finite {shape[0]} x {shape[1]} matrix"
+                            + (" (or a number, or its diagonal)" if diagonal and shape[0] == shape[1] else "")
+                            + f", got {value!r}")
+    return array
+
+
+def _names(fields: Fields, key: str, default=None, size: int | None = None) -> tuple[str, ...]:
+    """Signal names: one string or a list of them (``size`` of them when given)."""
+    value = fields.raw(key, default, "string or list of strings", "loop signal names")
+    if isinstance(value, str):
+        value = [value]
+    if value is None:
+        raise ScenarioError(f"{fields._name(key)}: required signal name(s) missing{fields._misspelt(key)}")
+    if not isinstance(value, (list, tuple)) or not value or not all(isinstance(v, str) for v in value):
+        raise ScenarioError(f"{fields._name(key)}: expected a signal name or a list of them, got {value!r}")
+    if size is not None and len(value) != size:
+        raise ScenarioError(f"{fields._name(key)}: expected {size} signal names, got {list(value)}")
+    return tuple(value)
+
+
+def _group(plant: System, names: tuple[str, ...], where: str, group: str) -> Signals:
+    """Signals named ``names`` with the units the plant gives them (its states, inputs or outputs), else ''."""
+    units = {}
+    for g in (plant.x, plant.u, plant.y):
+        units.update(zip(g.names, g.units))
+    return Signals(names, tuple(units.get(n, "") for n in names), group=group)
+
+
+def _integer(fields: Fields, key: str, default: int) -> int:
+    value = fields.raw(key, default, "integer", ">= 1")
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise ScenarioError(f"{fields._name(key)}: expected an integer >= 1, got {value!r}")
+    return value
+
+
+def _pid(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.feedback import pid
+
+    measured, output = _names(fields, "measured", size=1), _names(fields, "output", size=1)
+    reference = fields.raw("reference", 0.0, "number or signal name", "set-point (measured's unit)")
+    if not isinstance(reference, str):
+        reference = Fields({"reference": reference}, fields.path).number("reference")
+    limits = fields.raw("limits", None, "[lo, hi]", "output bounds (output's unit)")
+    if limits is not None:
+        limits = tuple(Fields({"limits": limits}, fields.path).vector("limits", 2))
+    gains = {key: fields.number(key, 0.0 if key != "kp" else None) for key in ("kp", "ki", "kd")}
+    return pid(name, _group(plant, measured, fields.path, "read"), reference,
+               output=_group(plant, output, fields.path, "published"), limits=limits, dt=dt, **gains)
+
+
+def _state_feedback(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.feedback import state_feedback
+
+    reads = _names(fields, "reads", plant.x.names)
+    publishes = _names(fields, "publishes", plant.u.names)
+    K = _matrix(fields, "gain", (len(publishes), len(reads)), diagonal=False)
+    return state_feedback(name, K, _group(plant, reads, fields.path, "read"),
+                          fields.vector("x_ref", len(reads)), fields.vector("u_ref", len(publishes)),
+                          _group(plant, publishes, fields.path, "published"))
+
+
+def _lqr(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.feedback import lqr
+
+    reads = _names(fields, "reads", plant.x.names, size=plant.x.size)
+    publishes = _names(fields, "publishes", plant.u.names, size=plant.u.size)
+    Q = _matrix(fields, "q", (plant.x.size,) * 2)
+    R = _matrix(fields, "r", (plant.u.size,) * 2)
+    return lqr(plant, Q, R, name=name, dt=dt, reads=_group(plant, reads, fields.path, "read"),
+               publishes=_group(plant, publishes, fields.path, "published"))
+
+
+def _open_loop(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.feedback import INTERPOLATIONS, open_loop
+
+    publishes = _names(fields, "publishes")
+    times = fields.raw("times", None, "list of numbers", "strictly increasing, s")
+    values = fields.raw("values", None, "list of rows", "one row (or number) per time")
+    if times is None or values is None:
+        raise ScenarioError(f"{fields.path}: an open_loop block needs times and values")
+    return open_loop(name, times, values, _group(plant, publishes, fields.path, "published"),
+                     fields.text("interpolation", "previous", choices=INTERPOLATIONS))
+
+
+def _luenberger(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.observers.luenberger import luenberger_observer
+
+    if fields.has("gain"):
+        L = _matrix(fields, "gain", (plant.x.size, plant.y.size), diagonal=False)
+    else:
+        from uvsym.verify import synthesize_observer_gain
+
+        decay = fields.number("decay", positive=True)
+        lin = plant.linearize()
+        L = synthesize_observer_gain(lin.A, lin.C, decay=decay).L
+    return observer_block(luenberger_observer(plant, L, dt, name=name))
+
+
+def _gaussian(kind: str):
+    def build(fields: Fields, plant: System, dt: float, name: str) -> Block:
+        from uvsym.observers import ekf, ukf
+
+        n, n_y = plant.x.size, plant.y.size
+        options = {"Q": _matrix(fields, "q", (n, n)), "R": _matrix(fields, "r", (n_y, n_y)),
+                   "P0": _matrix(fields, "p0", (n, n))}
+        factory = ukf if kind == "ukf" else ekf
+        return observer_block(factory(plant, dt=dt, name=name, **options))
+
+    return build
+
+
+def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.observers.lms import lms_monitor
+
+    measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
+    regressor = _group(plant, _names(fields, "regressor", size=1), fields.path, "input")
+    reference = fields.raw("reference", None, "string", "signal subtracted before regression", "none")
+    if reference is not None and not isinstance(reference, str):
+        raise ScenarioError(f"{fields.path}.reference: expected a signal name, got {reference!r}")
+    options = {key: _integer(fields, key, default) for key, default in
+               (("order", 10), ("window", 20), ("hold", 3), ("confirm", 10))}
+    options |= {key: fields.number(key, positive=True) for key in ("mu", "eps0", "r0")}
+    return observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
+                                      reference=None if reference is None else _group(plant, (reference,), "",
+                                                                                      "input"), **options))
+
+
+BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
+          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms}
+
+
+def build_block(fields: Fields, plant: System, dt: float) -> Block:
+    """The block a ``[[blocks]]`` table describes (module docstring), sampled every ``dt`` s.
+
+    Raises ScenarioError naming the field: an unknown type or field (with the close match), a
+    missing or malformed parameter, or a design that fails for the plant (the design's own message).
+    """
+    kind = fields.text("type", choices=tuple(BLOCKS))
+    name = fields.text("name", kind)
+    try:
+        built = BLOCKS[kind](fields, plant, dt, name)
+    except ScenarioError:
+        raise
+    except UvsymError as exc:
+        raise ScenarioError(f"{fields.path} ({kind} {name!r}): {exc}") from None
+    fields.done()
+    return built

@@ -1,0 +1,337 @@
+"""Scenarios over any System: a TOML file names the plant, the blocks wired by signal name, the
+faults, noise, set-points and detectors. Every field is checked before anything runs; an error
+names it (``blocks[1].decay``), with the close match of a misspelt key or name.
+
+Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
+``module:function`` returning a System, the module imported from ``plant_path``, default the
+scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
+``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
+``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
+``d``: constant disturbances), ``[noise]`` (output = standard deviation, the sensors'
+specification, acting the whole run), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
+``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
+estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
+``sensor`` = an output name, ``kind``, ``value`` and the profile fields of vehicle scenarios),
+``[substitutions]`` (``channel = { by = "signal", when = "flag signal" }``: while the flag is set
+every block reading channel reads the substitute, from the next sample) and ``[[detectors]]``:
+
+- ``type = "threshold"``: ``residuals`` (signal names ``<block>.<signal>``), ``targets`` (the
+  input or output each points to), ``false_alarms_per_hour`` (designed rate, default 1),
+  ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
+  linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
+  ``release`` (samples), ``ignore_before`` (s);
+- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions.
+
+Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
+from uvsym.errors import ScenarioError, UvsymError
+from uvsym.faults import ActuatorFault, SensorFault
+from uvsym.sim.blocks import Block
+from uvsym.sim.catalogue import _names, build_block
+from uvsym.sim.fields import Fields
+from uvsym.sim.result import SimResult
+from uvsym.sim.run import Substitution
+from uvsym.sim.scenario import fault_tables
+from uvsym.sim.system_simulation import initial_state, loop_inputs
+from uvsym.sim.wiring import WiredLoop, interconnect
+from uvsym.systems.system import System
+
+__all__ = ["SystemScenario", "FlagSubstitution", "parse_system_scenario", "is_system_scenario",
+           "simulate_system_scenario", "DETECTORS"]
+
+DETECTORS = ("threshold", "lms")
+
+
+def is_system_scenario(table: dict) -> bool:
+    """True for a scenario table over a System (it names ``plant``), False for a vehicle scenario."""
+    return "plant" in table
+
+
+@dataclass(frozen=True)
+class FlagSubstitution:
+    """Supervisor (:class:`uvsym.sim.run.Supervisor`): every sample, the channels whose flag signal
+    (``<block>.<label>``) is set (> 0.5) are substituted from the next sample on."""
+
+    flags: tuple[tuple[str, str, int], ...]  # (channel, block, column of the block's published row)
+    period: float
+
+    def update(self, t: np.ndarray, signals: dict[str, np.ndarray]) -> Substitution:
+        return Substitution({channel for channel, group, column in self.flags if signals[group][-1, column] > 0.5})
+
+
+@dataclass(frozen=True)
+class SystemScenario:
+    """A validated scenario over a System (module docstring): the wired ``loop``, its initial state
+    z0 (n_z,), disturbances d (n_d,), faults (their indices into the plant's inputs and outputs),
+    the substitution supervisor (None without substitutions) and the detectors."""
+
+    name: str
+    description: str
+    plant: System
+    duration: float
+    step: float
+    seed: int
+    loop: WiredLoop
+    z0: np.ndarray
+    d: np.ndarray
+    actuator_faults: tuple[ActuatorFault, ...]
+    sensor_faults: tuple[SensorFault, ...]
+    supervisor: FlagSubstitution | None
+    detectors: tuple
+    substitutions: dict
+
+    @property
+    def input_labels(self) -> tuple[str, ...]:
+        return self.plant.u.names
+
+    @property
+    def output_labels(self) -> tuple[str, ...]:
+        return self.plant.y.names
+
+
+def _close(name: str, known) -> str:
+    near = difflib.get_close_matches(name, list(known), n=1)
+    return f" (did you mean {near[0]!r}?)" if near else ""
+
+
+def _plant(top: Fields, root: Path) -> System:
+    """The plant a scenario names (module docstring); ScenarioError naming ``plant`` or its parameters."""
+    from uvsym.systems.registry import plant, plant_names
+
+    source = top.text("plant")
+    overrides = top.raw("plant_parameters", {}, "table", "keyword arguments of the plant's builder")
+    if not isinstance(overrides, dict):
+        raise ScenarioError("plant_parameters: expected a table of name = value")
+    folder = top.text("plant_path", str(root))
+    if ":" not in source:
+        if source not in plant_names():
+            raise ScenarioError(f"plant: unknown plant {source!r}{_close(source, plant_names())}; known: "
+                                f"{', '.join(plant_names())}; or give module:function returning a System")
+        try:
+            return plant(source, **overrides)
+        except UvsymError as exc:
+            raise ScenarioError(f"plant_parameters: {exc}") from None
+    module_name, _, function = source.partition(":")
+    path = Path(folder)
+    if not path.is_dir():
+        raise ScenarioError(f"plant_path: folder {folder} does not exist")
+    if str(path.resolve()) not in sys.path:
+        sys.path.insert(0, str(path.resolve()))
+    try:
+        factory = getattr(importlib.import_module(module_name), function)
+    except ImportError as exc:
+        raise ScenarioError(f"plant: cannot import module {module_name!r} (searched {path.resolve()} and the "
+                            f"installed packages): {exc}") from None
+    except AttributeError:
+        raise ScenarioError(f"plant: module {module_name!r} has no function {function!r}") from None
+    if not callable(factory):
+        raise ScenarioError(f"plant: {source} is a {type(factory).__name__}, not a function returning a System")
+    try:
+        built = factory(**overrides)
+    except UvsymError as exc:
+        raise ScenarioError(f"plant: {source}: {exc}") from None
+    except TypeError as exc:
+        raise ScenarioError(f"plant_parameters: {source} refuses them: {exc}") from None
+    if not isinstance(built, System):
+        raise ScenarioError(f"plant: {source} returned {type(built).__name__}, not a uvsym System")
+    return built
+
+
+def _point(fields: Fields, key: str, group, default: np.ndarray) -> np.ndarray:
+    """A vector of the group's signals: a list in order, or a table name = value (others default)."""
+    value = fields.raw(key, None, "list or table", f"one value per {group.group} ({', '.join(group.names)})")
+    if value is None:
+        return np.array(default, dtype=float)
+    if isinstance(value, dict):
+        vector = np.array(default, dtype=float)
+        for name in value:
+            if name not in group.names:
+                raise ScenarioError(f"{fields._name(key)}.{name}: unknown {group.group}{_close(name, group.names)}; "
+                                    f"known: {', '.join(group.names)}")
+            vector[group.index(name)] = Fields(value, fields._name(key)).number(name)
+        return vector
+    return Fields({key: value}, fields.path).vector(key, group.size)
+
+
+def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str, float]):
+    """The [[faults]] (:func:`uvsym.sim.scenario.fault_tables` over the plant's inputs and outputs),
+    the [noise] channels first as whole-run noise faults."""
+    actuator, sensor = fault_tables(items, plant.u.names, plant.y.names, duration, plant.name)
+    return actuator, tuple(SensorFault(plant.y.index(name), "noise", std) for name, std in noise.items()) + sensor
+
+
+def _setpoint(fields: Fields, plant: System, step: float) -> Block:
+    from uvsym.sim.catalogue import BLOCKS
+
+    signal = fields.text("signal")
+    data = {"type": "open_loop", "name": f"setpoint_{signal}", "publishes": signal,
+            **{k: v for k, v in fields.data.items() if k != "signal"}}
+    fields.used.update(fields.data)
+    table = Fields(data, fields.path, fields.schema)
+    table.used.update(("type", "name", "publishes"))
+    block = BLOCKS["open_loop"](table, plant, step, data["name"])
+    table.done()
+    return block
+
+
+def _substitutions(fields: Fields | None) -> tuple[dict[str, str], dict[str, str]]:
+    """(channel -> substitute, channel -> flag signal) of a [substitutions] table."""
+    if fields is None:
+        return {}, {}
+    fields.describe("<channel>", "table", "{ by = substitute signal, when = flag signal (0/1) }")
+    by, when = {}, {}
+    for channel in list(fields.data):
+        entry = Fields(fields.data[channel], fields._name(channel))
+        fields.used.add(channel)
+        by[channel], when[channel] = entry.text("by"), entry.text("when")
+        entry.done()
+    return by, when
+
+
+def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
+    from uvsym.diagnosis.calibration import residual_covariance
+
+    kind = fields.text("type", choices=DETECTORS)
+    name = fields.text("name", kind)
+    if kind == "lms":
+        monitor = fields.text("monitor")
+        blocks = {b.name: b for b in scenario_loop.blocks}
+        if monitor not in blocks or f"fault_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
+            lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
+            raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
+                                f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
+        fields.done()
+        return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0])
+    residuals = _names(fields, "residuals")
+    targets = fields.raw("targets", None, "list of strings", "the plant input or output each residual points to")
+    known = scenario_loop.plant.u.names + scenario_loop.plant.y.names
+    if targets is not None:
+        targets = [targets] if isinstance(targets, str) else targets
+        if not isinstance(targets, list) or len(targets) != len(residuals) or any(t not in known for t in targets):
+            raise ScenarioError(f"{fields.path}.targets: expected {len(residuals)} names of the plant's inputs or "
+                                f"outputs ({', '.join(known)}), got {targets!r}")
+    std = fields.vector("std", len(residuals))
+    options = {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 1.0, positive=True),
+               "ignore_before": fields.number("ignore_before", 0.0, minimum=0.0)}
+    for key, default in (("confirm", 3), ("release", 20)):
+        value = fields.raw(key, default, "integer", ">= 1 (samples)")
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ScenarioError(f"{fields.path}.{key}: expected an integer >= 1 (samples), got {value!r}")
+        options[key] = value
+    fields.done()
+    try:
+        if std is None:
+            std = np.sqrt(np.diag(residual_covariance(scenario_loop, z0, w0, residuals)))
+            silent = [r for r, s in zip(residuals, std) if not s > 0]
+            if silent:
+                raise ScenarioError(f"{fields.path}.std: no sensor noise reaches {', '.join(silent)} ([noise] is "
+                                    "empty for what it depends on): state the residuals' standard deviations")
+        return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
+    except ScenarioError:
+        raise
+    except UvsymError as exc:
+        raise ScenarioError(f"{fields.path} ({name}): {exc}") from None
+
+
+def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
+                          schema: dict | None = None) -> SystemScenario:
+    """Validate a scenario over a System given as a dict (the parsed TOML; module docstring) and
+    wire its loop; ``root``: the scenario file's folder; ``schema`` collects the fields read."""
+    top = Fields(data, "", schema)
+    name, description = top.text("name", default_name), top.text("description", "")
+    plant = _plant(top, Path(root))
+    duration, step = top.number("duration", positive=True), top.number("step", positive=True)
+    if abs(round(duration / step) * step - duration) > 1e-9 * duration:
+        raise ScenarioError(f"step: {step} s does not divide duration {duration} s")
+    if duration / step > 1e9:
+        raise ScenarioError(f"duration: {duration:g} s at step {step:g} s is more than 1e9 samples")
+    substeps = top.raw("substeps", 1, "integer", ">= 1 (RK4 steps per sample)")
+    seed = top.raw("seed", 0, "integer", ">= 0 (noise draws)")
+    for key, value, low in (("substeps", substeps, 1), ("seed", seed, 0)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < low:
+            raise ScenarioError(f"{key}: expected an integer >= {low}, got {value!r}")
+    initial = top.table("initial") or top.empty("initial")
+    x0 = _point(initial, "x", plant.x, plant.x_op)
+    d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
+    initial.done()
+    noise_fields = top.table("noise")
+    top.describe("noise.<output>", "number", "standard deviation of the output's sensor noise (its unit)", "none")
+    noise = {}
+    if noise_fields is not None:
+        for channel in list(noise_fields.data):
+            if channel not in plant.y.names:
+                raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
+                                    f"outputs: {', '.join(plant.y.names)}")
+            noise[channel] = noise_fields.number(channel, positive=True)
+    blocks = [_setpoint(f, plant, step) for f in top.tables("setpoints")]
+    blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
+    actuator_faults, sensor_faults = _faults(top.tables("faults"), plant, duration, noise)
+    by, when = _substitutions(top.table("substitutions"))
+    detector_tables = top.tables("detectors")
+    top.done()
+    try:
+        loop = interconnect(plant, blocks, dt=step, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
+                            substitutions=by, substeps=substeps)
+    except UvsymError as exc:
+        raise ScenarioError(f"blocks: {exc}") from None
+    flags = []
+    for channel, flag in when.items():
+        group, _, label = flag.partition(".")
+        entry = loop.signals.get(group)
+        if entry is None or label not in entry[1] or group in ("x", "y", "u"):
+            raise ScenarioError(f"substitutions.{channel}.when: {flag!r} is not a block's published signal "
+                                "(<block>.<signal>)")
+        flags.append((channel, group, list(entry[1]).index(label)))
+    W0 = loop_inputs(loop, 0, d, seed)
+    W0[0, 1:1 + plant.y.size] = 0.0
+    try:
+        z0 = initial_state(loop, x0, W0[0])
+    except UvsymError as exc:
+        raise ScenarioError(f"initial: {exc}") from None
+    names = {b.name for b in blocks}
+    detectors = []
+    for fields in detector_tables:
+        detector = _detector(fields, loop, z0, W0[0], step)
+        if detector.name in names:
+            raise ScenarioError(f"{fields.path}.name: {detector.name!r} names a block or detector already")
+        names.add(detector.name)
+        detectors.append(detector)
+    return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
+                          loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
+                          supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
+                          detectors=tuple(detectors), substitutions=by)
+
+
+
+def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", progress=None,
+                             compiled: bool = True, options: dict | None = None) -> SimResult:
+    """Run a validated :class:`SystemScenario`; every detector then decides on the finished record.
+
+    The result's ``events`` hold every detector's decisions in time order (each names its
+    ``detector``), its meta ``detectors`` each detector's design (rule, thresholds, designed rates).
+    """
+    from uvsym.sim.system_simulation import run_wired
+
+    N = round(scenario.duration / scenario.step)
+    W = loop_inputs(scenario.loop, N, scenario.d, scenario.seed)
+    result = run_wired(scenario.loop, scenario.z0, W, method=method, supervisor=scenario.supervisor,
+                       options=options, compiled=compiled, progress=progress, duration=scenario.duration,
+                       seed=scenario.seed, actuator_faults=scenario.actuator_faults,
+                       sensor_faults=scenario.sensor_faults,
+                       substitutions=scenario.substitutions)
+    events = sorted((e for detector in scenario.detectors for e in detector.decide(result)), key=lambda e: e.t)
+    meta = {"scenario": scenario.name, **result.meta, "events": [e.as_dict() for e in events],
+            "detectors": [detector.design() for detector in scenario.detectors]}
+    return SimResult(result.t, result.signals, meta)
