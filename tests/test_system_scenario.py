@@ -122,6 +122,10 @@ def test_bad_blocks_and_detectors_are_named():
     with pytest.raises(ScenarioError, match=r"blocks\[1\]\.decayy: unknown field \(did you mean 'decay'\?\)"):
         _parse(table)
     table = _table()
+    table["blocks"][1]["decay"] = 1e300
+    with pytest.raises(ScenarioError, match=r"blocks\[1\]\.decay: 1e\+300 1/s is not below 1/step = 1000 1/s"):
+        _parse(table)
+    table = _table()
     table["blocks"][0]["measured"] = "omega_hat"                  # both estimators publish it
     with pytest.raises(ScenarioError, match="'luenberger.omega_hat' or 'ukf.omega_hat'"):
         _parse(table)

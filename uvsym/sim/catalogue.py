@@ -142,11 +142,20 @@ def _luenberger(fields: Fields, plant: System, dt: float, name: str) -> Block:
     if fields.has("gain"):
         L = _matrix(fields, "gain", (plant.x.size, plant.y.size), diagonal=False)
     else:
+        import cvxpy
+
         from uvsym.verify import synthesize_observer_gain
 
         decay = fields.number("decay", positive=True)
+        if decay * dt >= 1.0:
+            raise ScenarioError(f"{fields.path}.decay: {decay:g} 1/s is not below 1/step = {1 / dt:g} 1/s; an "
+                                "observer sampled every step cannot decay faster")
         lin = plant.linearize()
-        L = synthesize_observer_gain(lin.A, lin.C, decay=decay).L
+        try:
+            L = synthesize_observer_gain(lin.A, lin.C, decay=decay).L
+        except cvxpy.error.SolverError as exc:
+            raise ScenarioError(f"{fields.path}.decay: the LMI solver failed at {decay:g} 1/s ({exc}); try a "
+                                "smaller rate") from None
     return observer_block(luenberger_observer(plant, L, dt, name=name))
 
 
