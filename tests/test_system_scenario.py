@@ -184,3 +184,47 @@ set = {{ duration = 4.0, faults = [] }}
         assert figures["detection_probability"] == 0.5 and figures["missed_detections"] == 1
         assert figures["healthy_hours"] == pytest.approx((4.0 + 3.0 + 3.0) / 3600)
     assert "## Detectors side by side" in (tmp_path / "out" / "report.md").read_text()
+
+
+def _sequential(outside, confirm, release):
+    """The decision rule sample by sample, as the module docstring states it: (sample, event) pairs."""
+    decisions, alarm, run_in, run_out = [], False, 0, 0
+    for k, over in enumerate(outside):
+        run_in, run_out = (run_in + 1, 0) if over else (0, run_out + 1)
+        if not alarm and run_in >= confirm:
+            alarm = True
+            decisions.append((k, "detected"))
+        elif alarm and run_out >= release:
+            alarm = False
+            decisions.append((k, "cleared"))
+    return decisions
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_threshold_decisions_follow_the_rule_sample_by_sample(seed):
+    from uvsym.diagnosis.detectors import ResidualThreshold
+    from uvsym.sim.result import Signal, SimResult
+
+    rng = np.random.default_rng(seed)
+    n = 3000
+    # bursts over the threshold of random lengths, so that confirm and release both bite
+    outside = np.repeat(rng.random(300) < 0.4, rng.integers(1, 8, 300))[:n]
+    t = 0.01 * np.arange(outside.size)
+    sigma = 0.5
+    detector = ResidualThreshold("d", ("obs.r",), [sigma], 0.01, confirm=int(rng.integers(1, 5)),
+                                 release=int(rng.integers(1, 9)), targets=("y",))
+    residual = np.where(outside, 1.5, 0.5) * detector.thresholds[0]
+    result = SimResult(t, {"obs": Signal(residual[:, None], ("r",), ("m",))}, {})
+    events = [(round(e.t / 0.01), e.event) for e in detector.decide(result) if e.event != "isolated"]
+    assert events == _sequential(outside, detector.confirm, detector.release)
+
+
+def test_a_campaign_substeps_option_is_refused_for_plant_scenarios(tmp_path):
+    from uvsym.errors import CampaignError
+
+    path = tmp_path / "c.toml"
+    path.write_text(f'name = "dc"\n[simulation]\nsubsteps = 4\n[[case]]\nname = "a"\nscenario = "{SCENARIO}"\n')
+    with pytest.raises(CampaignError, match="simulation.substeps: a scenario over a plant sets its own substeps"):
+        load_campaign(path)
+    path.write_text(f'name = "dc"\n[[case]]\nname = "a"\nscenario = "{SCENARIO}"\nset = {{ substeps = 4 }}\n')
+    assert load_campaign(path).runs[0].scenario["substeps"] == 4

@@ -138,6 +138,9 @@ def parse_campaign(data: dict, root=".", default_name: str = "campaign", *, conf
             raise CampaignError(f"case {run.case!r}: two runs have the same scenario ({_describe(run.fields)}); "
                                 "remove the repeated grid value")
         seen[run.id] = run
+    if "substeps" in dict(simulation) and any(is_system_scenario(run.scenario) for run in runs):
+        raise CampaignError("simulation.substeps: a scenario over a plant sets its own substeps (substeps = N in "
+                            "the scenario, or a case's set)")
     columns = tuple(dict.fromkeys(column for run in runs for column in run.fields))
     if roc_by is None:
         roc_by = [c for c in columns if parse_path(c)[0] in _SETTING_ROOTS]

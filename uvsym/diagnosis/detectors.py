@@ -91,19 +91,22 @@ class ResidualThreshold:
         t = np.asarray(result.t, dtype=float)
         ratio = np.column_stack([np.abs(read_signal(result, r)) / c for r, c in zip(self.residuals, self.thresholds)])
         ratio[t < self.ignore_before - 1e-9 * max(1.0, abs(self.ignore_before))] = 0.0
-        outside = ratio.max(axis=1) > 1.0
-        events, alarm, run_in, run_out = [], False, 0, 0
-        for k, over in enumerate(outside):
-            run_in, run_out = (run_in + 1, 0) if over else (0, run_out + 1)
-            if not alarm and run_in >= self.confirm:
-                alarm = True
-                target, time = self.targets[int(np.argmax(ratio[k]))], round(float(t[k]), 9)
-                events.append(Event(time, "detected", target, detector=self.name))
-                if target is not None:
-                    events.append(Event(time, "isolated", target, detector=self.name))
-            elif alarm and run_out >= self.release:
-                alarm = False
-                events.append(Event(round(float(t[k]), 9), "cleared", detector=self.name))
+        outside = (ratio.max(axis=1) > 1.0).astype(int)
+        # samples ending a run of `confirm` samples outside, and of `release` samples inside
+        confirmed = np.flatnonzero(np.convolve(outside, np.ones(self.confirm, int))[:t.size] >= self.confirm)
+        released = np.flatnonzero(np.convolve(1 - outside, np.ones(self.release, int))[:t.size] >= self.release)
+        events, k = [], -1
+        while (i := np.searchsorted(confirmed, k, side="right")) < confirmed.size:
+            k = int(confirmed[i])  # the first confirmation after the last clearance: an alarm
+            target, time = self.targets[int(np.argmax(ratio[k]))], round(float(t[k]), 9)
+            events.append(Event(time, "detected", target, detector=self.name))
+            if target is not None:
+                events.append(Event(time, "isolated", target, detector=self.name))
+            j = np.searchsorted(released, k, side="right")
+            if j == released.size:
+                break
+            k = int(released[j])  # the first release after it: cleared
+            events.append(Event(round(float(t[k]), 9), "cleared", detector=self.name))
         return events
 
     def design(self) -> dict:

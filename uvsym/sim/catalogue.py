@@ -26,13 +26,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.sim.blocks import Block, observer_block
 from uvsym.sim.fields import Fields
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
-__all__ = ["BLOCKS", "build_block"]
+__all__ = ["BLOCKS", "build_block", "schedule"]
 
 
 def _matrix(fields: Fields, key: str, shape: tuple[int, int], default=None, *, diagonal: bool = True) -> np.ndarray:
@@ -80,13 +81,6 @@ def _group(plant: System, names: tuple[str, ...], where: str, group: str) -> Sig
     return Signals(names, tuple(units.get(n, "") for n in names), group=group)
 
 
-def _integer(fields: Fields, key: str, default: int) -> int:
-    value = fields.raw(key, default, "integer", ">= 1")
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise ScenarioError(f"{fields._name(key)}: expected an integer >= 1, got {value!r}")
-    return value
-
-
 def _pid(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.sim.feedback import pid
 
@@ -125,13 +119,18 @@ def _lqr(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
 
 def _open_loop(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    return schedule(fields, plant, name, _names(fields, "publishes"))
+
+
+def schedule(fields: Fields, plant: System, name: str, publishes: tuple[str, ...]) -> Block:
+    """A time table (``times``, ``values``, ``interpolation``) publishing ``publishes``: an open_loop
+    block, or a scenario's set-point schedule."""
     from uvsym.sim.feedback import INTERPOLATIONS, open_loop
 
-    publishes = _names(fields, "publishes")
     times = fields.raw("times", None, "list of numbers", "strictly increasing, s")
     values = fields.raw("values", None, "list of rows", "one row (or number) per time")
     if times is None or values is None:
-        raise ScenarioError(f"{fields.path}: an open_loop block needs times and values")
+        raise ScenarioError(f"{fields.path}: a time table needs times and values")
     return open_loop(name, times, values, _group(plant, publishes, fields.path, "published"),
                      fields.text("interpolation", "previous", choices=INTERPOLATIONS))
 
@@ -180,7 +179,7 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
     reference = fields.raw("reference", None, "string", "signal subtracted before regression", "none")
     if reference is not None and not isinstance(reference, str):
         raise ScenarioError(f"{fields.path}.reference: expected a signal name, got {reference!r}")
-    options = {key: _integer(fields, key, default) for key, default in
+    options = {key: fields.integer(key, default, minimum=1, unit="samples") for key, default in
                (("order", 10), ("window", 20), ("hold", 3), ("confirm", 10))}
     options |= {key: fields.number(key, positive=True) for key in ("mu", "eps0", "r0")}
     return observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
@@ -195,9 +194,18 @@ BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loo
 def build_block(fields: Fields, plant: System, dt: float) -> Block:
     """The block a ``[[blocks]]`` table describes (module docstring), sampled every ``dt`` s.
 
+    Memoized in-process by the table's content, its path, the plant object and dt (gain designs are
+    made once: the runs of a campaign differ in faults, not in their blocks).
+
     Raises ScenarioError naming the field: an unknown type or field (with the close match), a
     missing or malformed parameter, or a design that fails for the plant (the design's own message).
     """
+    return _built(fields.data, fields.path, plant, dt)
+
+
+@memoized(64)
+def _built(data: dict, path: str, plant: System, dt: float) -> Block:
+    fields = Fields(data, path)
     kind = fields.text("type", choices=tuple(BLOCKS))
     name = fields.text("name", kind)
     try:

@@ -73,6 +73,15 @@ class Fields:
             raise ScenarioError(f"{self._name(key)}: must be >= {minimum}, got {value}")
         return float(value)
 
+    def integer(self, key: str, default=None, *, minimum: int = 0, unit: str = "") -> int:
+        """An integer >= minimum (bools refused); ``unit`` only describes it (``samples``)."""
+        rule = f">= {minimum}" + (f" ({unit})" if unit else "")
+        value = self.raw(key, default, "integer", rule)
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            missing = self._misspelt(key) if value is None else ""
+            raise ScenarioError(f"{self._name(key)}: expected an integer {rule}, got {value!r}{missing}")
+        return value
+
     def text(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
         value = self.raw(key, default, "string", "" if choices is None else "one of " + ", ".join(choices))
         if not isinstance(value, str):

@@ -35,11 +35,12 @@ from pathlib import Path
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
-from uvsym.sim.catalogue import _names, build_block
+from uvsym.sim.catalogue import _names, build_block, schedule
 from uvsym.sim.fields import Fields
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Substitution
@@ -123,6 +124,14 @@ def _plant(top: Fields, root: Path) -> System:
             return plant(source, **overrides)
         except UvsymError as exc:
             raise ScenarioError(f"plant_parameters: {exc}") from None
+    return _user_plant(source, folder, overrides)
+
+
+@memoized(16)
+def _user_plant(source: str, folder: str, overrides: dict) -> System:
+    """The System ``module:function`` returns for ``overrides``, the module imported from ``folder``;
+    memoized in-process (as registered plants are), so that the scenarios of a campaign share one
+    plant object and with it their blocks' designs."""
     module_name, _, function = source.partition(":")
     path = Path(folder)
     if not path.is_dir():
@@ -172,17 +181,11 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
     return actuator, tuple(SensorFault(plant.y.index(name), "noise", std) for name, std in noise.items()) + sensor
 
 
-def _setpoint(fields: Fields, plant: System, step: float) -> Block:
-    from uvsym.sim.catalogue import BLOCKS
-
+def _setpoint(fields: Fields, plant: System) -> Block:
+    """A [[setpoints]] table: the schedule of one signal, as the block ``setpoint_<signal>``."""
     signal = fields.text("signal")
-    data = {"type": "open_loop", "name": f"setpoint_{signal}", "publishes": signal,
-            **{k: v for k, v in fields.data.items() if k != "signal"}}
-    fields.used.update(fields.data)
-    table = Fields(data, fields.path, fields.schema)
-    table.used.update(("type", "name", "publishes"))
-    block = BLOCKS["open_loop"](table, plant, step, data["name"])
-    table.done()
+    block = schedule(fields, plant, f"setpoint_{signal}", (signal,))
+    fields.done()
     return block
 
 
@@ -226,10 +229,7 @@ def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.n
     options = {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 1.0, positive=True),
                "ignore_before": fields.number("ignore_before", 0.0, minimum=0.0)}
     for key, default in (("confirm", 3), ("release", 20)):
-        value = fields.raw(key, default, "integer", ">= 1 (samples)")
-        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ScenarioError(f"{fields.path}.{key}: expected an integer >= 1 (samples), got {value!r}")
-        options[key] = value
+        options[key] = fields.integer(key, default, minimum=1, unit="samples")
     fields.done()
     try:
         if std is None:
@@ -257,11 +257,8 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
         raise ScenarioError(f"step: {step} s does not divide duration {duration} s")
     if duration / step > 1e9:
         raise ScenarioError(f"duration: {duration:g} s at step {step:g} s is more than 1e9 samples")
-    substeps = top.raw("substeps", 1, "integer", ">= 1 (RK4 steps per sample)")
-    seed = top.raw("seed", 0, "integer", ">= 0 (noise draws)")
-    for key, value, low in (("substeps", substeps, 1), ("seed", seed, 0)):
-        if isinstance(value, bool) or not isinstance(value, int) or value < low:
-            raise ScenarioError(f"{key}: expected an integer >= {low}, got {value!r}")
+    substeps = top.integer("substeps", 1, minimum=1, unit="RK4 steps per sample")
+    seed = top.integer("seed", 0, unit="noise draws")
     initial = top.table("initial") or top.empty("initial")
     x0 = _point(initial, "x", plant.x, plant.x_op)
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
@@ -275,7 +272,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
                 raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
                                     f"outputs: {', '.join(plant.y.names)}")
             noise[channel] = noise_fields.number(channel, positive=True)
-    blocks = [_setpoint(f, plant, step) for f in top.tables("setpoints")]
+    blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
     blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
     actuator_faults, sensor_faults = _faults(top.tables("faults"), plant, duration, noise)
     by, when = _substitutions(top.table("substitutions"))
