@@ -25,7 +25,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import norm
 
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError
@@ -49,7 +48,9 @@ def threshold_factor(false_alarms_per_hour: float, dt: float, channels: int) -> 
     if not 0.0 < alpha < 1.0:
         raise DiagnosisError(f"false_alarms_per_hour = {false_alarms_per_hour:g} at dt = {dt:g} s gives a per-sample "
                              f"probability of {alpha:g}, outside (0, 1)")
-    return float(norm.isf(alpha / (2 * channels)))
+    from scipy.special import ndtri  # here: scipy.stats would cost every CLI call its import
+
+    return float(-ndtri(alpha / (2 * channels)))
 
 
 @dataclass(frozen=True)
