@@ -36,16 +36,34 @@ def shipped():
     return scenario, simulate_system_scenario(scenario)
 
 
-def test_both_estimators_detect_and_isolate_the_speed_bias_soon_after_its_onset(shipped):
+def test_both_estimators_detect_the_speed_bias_soon_after_its_onset(shipped):
     scenario, result = shipped
     assert {"luenberger", "ukf"} <= set(result.signals)         # same names, told apart by their blocks
     events = result.events
     assert all(set(e) == {"t", "event", "target", "kind", "value", "detector"} for e in events)
     for detector in ("luenberger_fd", "ukf_fd"):
         own = [e for e in events if e["detector"] == detector]
-        assert own[0]["event"] == "detected" and 3.0 <= own[0]["t"] <= 3.05
-        assert own[1] == {**own[0], "event": "isolated"} and own[1]["target"] == "omega_meas"
+        assert own[0]["event"] == "detected" and 3.0 <= own[0]["t"] <= 3.05 and own[0]["target"] == "omega_meas"
+        assert [e["event"] for e in own[1:]] == ["cleared"]    # unstructured residuals: no isolation claimed
     assert not [e for e in events if e["t"] < 3.0]               # nothing before the onset: no false alarm
+
+
+def test_isolation_is_claimed_only_for_structured_residuals():
+    """An actuator fault moves the current residual as a current-sensor fault does: without isolate the
+    detector must not name a culprit; with isolate (the user's claim) it isolates the largest one's target."""
+    loss = [{"actuator": "V", "kind": "proportional", "value": 0.5, "onset": 3.0}]
+    events = simulate_system_scenario(_parse(_table(faults=loss))).events
+    assert [e for e in events if e["event"] == "detected"] and not [e for e in events if e["event"] == "isolated"]
+    table = _table()
+    table["detectors"][0]["isolate"] = True
+    events = simulate_system_scenario(_parse(table)).events
+    isolated = [e for e in events if e["event"] == "isolated"]
+    assert [(e["detector"], e["target"]) for e in isolated] == [("luenberger_fd", "omega_meas")]
+    detected = next(e for e in events if e["event"] == "detected" and e["detector"] == "luenberger_fd")
+    assert isolated[0]["t"] == detected["t"]
+    table["detectors"][0].pop("targets")
+    with pytest.raises(ScenarioError, match=r"detectors\[0\]\.isolate: expected true \(with targets\) or false"):
+        _parse(table)
 
 
 def test_the_residual_spread_computed_from_the_noise_model_matches_a_long_healthy_run():
@@ -176,7 +194,8 @@ set = {{ duration = 4.0, faults = [] }}
     by_size = {r["true_value"]: r for r in rows}
     for detector in ("luenberger_fd", "ukf_fd"):
         assert by_size[3.0][f"{detector}:detected"] and not by_size[0.05][f"{detector}:detected"]
-        assert by_size[3.0][f"{detector}:isolation_delay_s"] < 0.05
+        assert by_size[3.0][f"{detector}:detection_delay_s"] < 0.05
+        assert by_size[3.0][f"{detector}:isolation_delay_s"] is None     # detection only (isolate unset)
         assert by_size[None][f"{detector}:false_alarms"] == 0
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert set(summary["detectors"]) == {"luenberger_fd", "ukf_fd"}

@@ -10,9 +10,12 @@ with ``z = Phi^-1(1 - alpha / (2 m))`` and ``alpha = F dt / 3600``: under the st
 :func:`~uvsym.diagnosis.calibration.residual_covariance` or given) a healthy sample exceeds some
 threshold with probability at most alpha (Bonferroni), so the expected number of samples that
 exceed, and hence of alarms, is at most F per hour (F: the designed false alarms per hour), for
-correlated residuals too. ``detected`` once ``confirm`` samples in a row exceed, and ``isolated`` on the
-residual's target with the largest ``|r_i| / c_i`` there (where targets are given); ``cleared`` once ``release`` samples
-in a row do not (hysteresis: no alarm stays latched after its evidence is gone). Samples before
+correlated residuals too. ``detected`` once ``confirm`` samples in a row exceed, naming the target
+of the residual with the largest ``|r_i| / c_i`` there (a hint); ``isolated`` on that target too
+only with ``isolate`` set, which claims that the residuals are structured (each one responds to
+its target's fault alone): an observer's output residuals are not (an actuator fault moves them
+as a sensor fault does), so by default the detector detects and does not isolate. ``cleared``
+once ``release`` samples in a row do not (hysteresis: no alarm stays latched after its evidence is gone). Samples before
 ``ignore_before`` s (the estimator's start-up) are not judged.
 
 :class:`DoubleCriterion` -- the LMS-FIR monitor's own decision (Zhu et al., Sec. 3.2; published
@@ -56,7 +59,8 @@ def threshold_factor(false_alarms_per_hour: float, dt: float, channels: int) -> 
 @dataclass(frozen=True)
 class ResidualThreshold:
     """Threshold test on residuals (module docstring). residuals: m signal names; sigma: (m,) their
-    standard deviations (residuals' units); targets: the signal each residual points to (an input
+    standard deviations (residuals' units); isolate: the residuals are structured (module
+    docstring); targets: the signal each residual points to (an input
     or output of the plant) or None; dt: sample period (s)."""
 
     name: str
@@ -68,6 +72,7 @@ class ResidualThreshold:
     release: int = 20
     ignore_before: float = 0.0
     targets: tuple[str | None, ...] = ()
+    isolate: bool = False
     thresholds: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -101,7 +106,7 @@ class ResidualThreshold:
             k = int(confirmed[i])  # the first confirmation after the last clearance: an alarm
             target, time = self.targets[int(np.argmax(ratio[k]))], round(float(t[k]), 9)
             events.append(Event(time, "detected", target, detector=self.name))
-            if target is not None:
+            if self.isolate and target is not None:
                 events.append(Event(time, "isolated", target, detector=self.name))
             j = np.searchsorted(released, k, side="right")
             if j == released.size:

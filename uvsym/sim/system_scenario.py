@@ -16,7 +16,8 @@ estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input
 every block reading channel reads the substitute, from the next sample) and ``[[detectors]]``:
 
 - ``type = "threshold"``: ``residuals`` (signal names ``<block>.<signal>``), ``targets`` (the
-  input or output each points to), ``false_alarms_per_hour`` (designed rate, default 1),
+  input or output each points to), ``isolate`` (the residuals are structured, so the largest one
+  isolates its target; default false: detection only, :mod:`uvsym.diagnosis.detectors`), ``false_alarms_per_hour`` (designed rate, default 1),
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
@@ -228,6 +229,10 @@ def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.n
     std = fields.vector("std", len(residuals))
     options = {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 1.0, positive=True),
                "ignore_before": fields.number("ignore_before", 0.0, minimum=0.0)}
+    options["isolate"] = fields.raw("isolate", False, "boolean", "the residuals are structured")
+    if not isinstance(options["isolate"], bool) or (options["isolate"] and targets is None):
+        raise ScenarioError(f"{fields.path}.isolate: expected true (with targets) or false, got "
+                            f"{options['isolate']!r}")
     for key, default in (("confirm", 3), ("release", 20)):
         options[key] = fields.integer(key, default, minimum=1, unit="samples")
     fields.done()
