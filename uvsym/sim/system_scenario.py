@@ -17,7 +17,8 @@ every block reading channel reads the substitute, from the next sample) and ``[[
 
 - ``type = "threshold"``: ``residuals`` (signal names ``<block>.<signal>``), ``targets`` (the
   input or output each points to), ``isolate`` (the residuals are structured, so the largest one
-  isolates its target; default false: detection only, :mod:`uvsym.diagnosis.detectors`), ``false_alarms_per_hour`` (designed rate, default 1),
+  isolates its target; default false: detection only, :mod:`uvsym.diagnosis.detectors`),
+  ``false_alarms_per_hour`` (designed rate, default 1),
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
