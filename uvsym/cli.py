@@ -175,17 +175,12 @@ def _simulate_study(study_name, table: dict, name: str, method: str | None):
 
 
 def _cmd_simulate(args) -> int:
+    from uvsym.campaign.metrics import detector_names
     from uvsym.derivation import study_scenarios
     from uvsym.progress import ProgressBar
     from uvsym.sim.result import SimResult
-    from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
-    from uvsym.sim.simulation import simulate_scenario
-    from uvsym.sim.system_scenario import (
-        SystemScenario,
-        is_system_scenario,
-        parse_system_scenario,
-        simulate_system_scenario,
-    )
+    from uvsym.sim.scenario import read_scenario_file, shipped_scenarios
+    from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
 
     if args.schema:
         from uvsym.sim.schema import schema_markdown
@@ -201,10 +196,7 @@ def _cmd_simulate(args) -> int:
     if args.out:  # format, folder and an existing file checked before the run
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
-    if is_system_scenario(table):
-        scenario = parse_system_scenario(table, default_name=path.stem, root=path.parent)
-    else:
-        scenario = None if "study" in table else parse_scenario(table, default_name=path.stem)
+    scenario = None if "study" in table else parse_any_scenario(table, default_name=path.stem, root=path.parent)
     if args.events is not None:
         _check_events_path(args.events, scenario, args.force)
     figure = None
@@ -217,10 +209,8 @@ def _cmd_simulate(args) -> int:
     else:
         method = args.method or "fast"
         bar = ProgressBar(f"{scenario.name} ({method})")
-        if isinstance(scenario, SystemScenario):
-            result, what = simulate_system_scenario(scenario, method=method, progress=bar), scenario.plant.name
-        else:
-            result, what = simulate_scenario(scenario, method=method, progress=bar), scenario.model.name
+        result = simulate_any_scenario(scenario, method=method, progress=bar)
+        what = (scenario.plant if hasattr(scenario, "plant") else scenario.model).name
         bar.close()
         wall = result.meta["wall_s"]
         print(f"{scenario.name}: {what}, {scenario.duration:g} s at {scenario.step:g} s, method "
@@ -230,7 +220,7 @@ def _cmd_simulate(args) -> int:
         print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
-    if _has_detectors(scenario):
+    if detector_names(scenario):  # a vehicle's [diagnosis] table, or [[detectors]]
         print(_event_lines(result.events))
     if getattr(scenario, "diagnosis", None) is not None:
         print(_decisions(result.events))
@@ -256,11 +246,6 @@ def _decisions(events: list[dict]) -> str:
     return f"diagnosis: {len(events)} events; faults standing at the end: {faults or 'none'}"
 
 
-def _has_detectors(scenario) -> bool:
-    """True when the scenario decides anything: a vehicle's [diagnosis] table, or [[detectors]]."""
-    return getattr(scenario, "diagnosis", None) is not None or bool(getattr(scenario, "detectors", ()))
-
-
 def _event_lines(events: list[dict]) -> str:
     """Every detector's decisions, one line per event: time, detector, event, target, kind and value."""
     if not events:
@@ -276,8 +261,10 @@ def _event_lines(events: list[dict]) -> str:
 def _check_events_path(path, scenario, force: bool) -> None:
     """UvsymError before the run: --events needs a scenario with detectors (a vehicle's [diagnosis] table
     or [[detectors]]), a .json file whose folder exists, and --force to replace a file."""
+    from uvsym.campaign.metrics import detector_names
+
     target = Path(path)
-    if not _has_detectors(scenario):
+    if not detector_names(scenario):
         raise UvsymError("--events: the scenario has no detector ([diagnosis] for a vehicle, [[detectors]] for a "
                          "plant), so there is no decision log to write (uvsym simulate --schema lists the fields)")
     if not str(path).strip() or target.suffix != ".json":

@@ -36,11 +36,10 @@ import numpy as np
 from uvsym.campaign.dotted import flatten, parse_path, set_path
 from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError
 from uvsym.sim.fields import Fields
-from uvsym.sim.scenario import parse_scenario, read_scenario_file, shipped_scenarios
-from uvsym.sim.system_scenario import is_system_scenario, parse_system_scenario
+from uvsym.sim.scenario import read_scenario_file, shipped_scenarios
+from uvsym.sim.system_scenario import is_system_scenario, parse_any_scenario
 
-__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "parse_any_scenario", "DISTRIBUTIONS",
-           "EXECUTORS"]
+__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS"]
 
 DISTRIBUTIONS = ("uniform", "normal", "integers", "choice")
 EXECUTORS = ("local", "dask")
@@ -346,13 +345,6 @@ def _expand(spec: dict) -> list[Run]:
                 drawn_fields |= flatten(path, value)
             runs.append(_run(name, draw, drawn_fields, drawn, spec["scenario"]))
     return runs
-
-
-def parse_any_scenario(table: dict, default_name: str = "scenario"):
-    """The validated scenario of a campaign run's table: over a plant (``plant = ...``) or a vehicle."""
-    if is_system_scenario(table):
-        return parse_system_scenario(table, default_name=default_name)
-    return parse_scenario(table, default_name=default_name)
 
 
 def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str) -> Run:

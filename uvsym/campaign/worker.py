@@ -44,7 +44,7 @@ def _base(run: Run) -> dict:
 
 def failure_row(run: Run, message: str) -> dict:
     """The error row of a run that gave no row of its own (e.g. its worker process died)."""
-    from uvsym.campaign.spec import parse_any_scenario
+    from uvsym.sim.system_scenario import parse_any_scenario
 
     return _base(run) | truth(parse_any_scenario(run.scenario)) | {"status": "error", "error": message}
 
@@ -52,17 +52,14 @@ def failure_row(run: Run, message: str) -> dict:
 def execute(run: Run, settings: Settings, hook=None) -> dict:
     """Simulate ``run`` and return its row: run_id, case, draw, its fields, status, error, the
     metrics of :func:`uvsym.campaign.metrics.run_metrics`, the hook's columns and wall_s (s)."""
-    from uvsym.campaign.spec import parse_any_scenario
-    from uvsym.sim.simulation import simulate_scenario
-    from uvsym.sim.system_scenario import SystemScenario, simulate_system_scenario
+    from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
 
     started = time.perf_counter()
     row = _base(run)
     try:
         scenario = parse_any_scenario(run.scenario)
         row |= truth(scenario)
-        simulate = simulate_system_scenario if isinstance(scenario, SystemScenario) else simulate_scenario
-        result = simulate(scenario, **dict(settings.simulation))
+        result = simulate_any_scenario(scenario, **dict(settings.simulation))
         events = list(getattr(result, "events", None) or [])
         row |= run_metrics(scenario, result, events)
         if hook is not None:

@@ -52,7 +52,7 @@ from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
 __all__ = ["SystemScenario", "FlagSubstitution", "parse_system_scenario", "is_system_scenario",
-           "simulate_system_scenario", "DETECTORS"]
+           "simulate_system_scenario", "parse_any_scenario", "simulate_any_scenario", "DETECTORS"]
 
 DETECTORS = ("threshold", "lms")
 
@@ -338,3 +338,23 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     meta = {"scenario": scenario.name, **result.meta, "events": [e.as_dict() for e in events],
             "detectors": [detector.design() for detector in scenario.detectors]}
     return SimResult(result.t, result.signals, meta)
+
+
+def parse_any_scenario(table: dict, default_name: str = "scenario", root="."):
+    """The validated scenario of a parsed table: a :class:`SystemScenario` when it names a ``plant``,
+    else a vehicle :class:`~uvsym.sim.scenario.Scenario`; root: the file's folder."""
+    from uvsym.sim.scenario import parse_scenario
+
+    if is_system_scenario(table):
+        return parse_system_scenario(table, default_name=default_name, root=root)
+    return parse_scenario(table, default_name=default_name)
+
+
+def simulate_any_scenario(scenario, **options) -> SimResult:
+    """Run either kind of scenario (:func:`simulate_system_scenario` or
+    :func:`uvsym.sim.simulation.simulate_scenario`, whose options it passes on)."""
+    if isinstance(scenario, SystemScenario):
+        return simulate_system_scenario(scenario, **options)
+    from uvsym.sim.simulation import simulate_scenario
+
+    return simulate_scenario(scenario, **options)
