@@ -10,7 +10,7 @@ detectors; 6 s at 1 ms), each figure the median of single calls:
 - ``cli_s``: ``uvsym simulate FILE`` end to end in a new process (imports, parse, run, printing);
 - ``hour_simulate_s`` / ``hour_decide_s``: a healthy hour at 10 ms (360,001 samples), simulation
   and the detectors' decisions on its record;
-- ``campaign_s``: ``uvsym campaign examples/dc_motor/campaign.toml`` (34 runs, 2 workers) end to
+- ``campaign_s``: ``uvsym campaign examples/dc_motor/campaign.toml`` (48 runs, 2 workers) end to
   end, with ``campaign_sim_s_per_wall_s`` the simulated seconds per wall second.
 
 Run: ``python benchmarks/system_scenario.py`` (writes ``benchmarks/results/system_scenario.json``).
