@@ -54,9 +54,6 @@ from uvsym.systems.system import System
 __all__ = ["SystemScenario", "FlagSubstitution", "parse_system_scenario", "is_system_scenario",
            "simulate_system_scenario", "parse_any_scenario", "simulate_any_scenario", "DETECTORS"]
 
-DETECTORS = ("threshold", "lms")
-
-
 def is_system_scenario(table: dict) -> bool:
     """True for a scenario table over a System (it names ``plant``), False for a vehicle scenario."""
     return "plant" in table
@@ -205,20 +202,23 @@ def _substitutions(fields: Fields | None) -> tuple[dict[str, str], dict[str, str
     return by, when
 
 
-def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
+def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                  step: float) -> DoubleCriterion:
+    """``type = "lms"``: the double criterion of the lms block named ``monitor``."""
+    monitor = fields.text("monitor")
+    blocks = {b.name: b for b in scenario_loop.blocks}
+    if monitor not in blocks or f"fault_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
+        lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
+        raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
+                            f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
+    return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0])
+
+
+def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                        step: float) -> ResidualThreshold:
+    """``type = "threshold"``: residual thresholds designed for a false-alarm rate (module docstring)."""
     from uvsym.diagnosis.calibration import residual_covariance
 
-    kind = fields.text("type", choices=DETECTORS)
-    name = fields.text("name", kind)
-    if kind == "lms":
-        monitor = fields.text("monitor")
-        blocks = {b.name: b for b in scenario_loop.blocks}
-        if monitor not in blocks or f"fault_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
-            lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
-            raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
-                                f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
-        fields.done()
-        return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0])
     residuals = _names(fields, "residuals")
     targets = fields.raw("targets", None, "list of strings", "the plant input or output each residual points to")
     known = scenario_loop.plant.u.names + scenario_loop.plant.y.names
@@ -237,18 +237,31 @@ def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.n
     for key, default in (("confirm", 3), ("release", 20)):
         options[key] = fields.integer(key, default, minimum=1, unit="samples")
     fields.done()
+    if std is None:
+        std = np.sqrt(np.diag(residual_covariance(scenario_loop, z0, w0, residuals)))
+        silent = [r for r, s in zip(residuals, std) if not s > 0]
+        if silent:
+            raise ScenarioError(f"{fields.path}.std: no sensor noise reaches {', '.join(silent)} ([noise] is "
+                                "empty for what it depends on): state the residuals' standard deviations")
+    return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
+
+
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector}
+
+
+def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
+    """The detector a ``[[detectors]]`` table describes: ``DETECTORS[type](fields, name, loop, z0, w0,
+    step)``, each builder reading its own fields; ScenarioError naming the field."""
+    kind = fields.text("type", choices=tuple(DETECTORS))
+    name = fields.text("name", kind)
     try:
-        if std is None:
-            std = np.sqrt(np.diag(residual_covariance(scenario_loop, z0, w0, residuals)))
-            silent = [r for r, s in zip(residuals, std) if not s > 0]
-            if silent:
-                raise ScenarioError(f"{fields.path}.std: no sensor noise reaches {', '.join(silent)} ([noise] is "
-                                    "empty for what it depends on): state the residuals' standard deviations")
-        return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
+        detector = DETECTORS[kind](fields, name, scenario_loop, z0, w0, step)
     except ScenarioError:
         raise
     except UvsymError as exc:
         raise ScenarioError(f"{fields.path} ({name}): {exc}") from None
+    fields.done()
+    return detector
 
 
 def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
