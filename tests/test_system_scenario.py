@@ -15,6 +15,7 @@ from uvsym.diagnosis.calibration import residual_covariance
 from uvsym.diagnosis.detectors import threshold_factor
 from uvsym.errors import ScenarioError
 from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
+from uvsym.sim.system_simulation import loop_inputs
 
 EXAMPLE = Path(__file__).parents[1] / "examples" / "dc_motor"
 SCENARIO = EXAMPLE / "speed_sensor_bias.toml"
@@ -72,8 +73,8 @@ def test_the_residual_spread_computed_from_the_noise_model_matches_a_long_health
     table["blocks"] = [b for b in table["blocks"] if b["type"] != "ukf"]
     scenario = _parse(table)
     names = ("luenberger.r_i_meas", "luenberger.r_omega_meas")
-    predicted = np.sqrt(np.diag(residual_covariance(scenario.loop, scenario.z0,
-                                                    np.r_[0.0, np.zeros(scenario.loop.n_w - 1)], names)))
+    w0 = loop_inputs(scenario.loop, 0, scenario.d, scenario.seed)[0]  # the sensor-noise levels live in w
+    predicted = np.sqrt(np.diag(residual_covariance(scenario.loop, scenario.z0, w0, names)))
     result = simulate_system_scenario(scenario)
     settled = result.t > 2.0
     measured = np.array([np.std(result["luenberger"][n.split(".")[1]][settled]) for n in names])

@@ -7,6 +7,9 @@ A fault changes a healthy value ``v`` (an actuator's applied value, or a measure
 where ``phi(t)`` in [0, 1] is the fault's time profile and ``target`` its kind (Liu et al. 2014,
 Definition 1, for actuators). Everything is a CasADi expression of ``t``, so integrators, the
 fixed-step path and generated code all see the same fault; ``phi`` is exactly 0 before onset.
+A fault's numbers (:data:`FAULT_PARAMETERS`: value and profile times) can be symbols instead
+(:func:`symbolic_fault`), so that one compiled loop runs every fault of the same shape (target,
+kind, profile kind), the numbers given per run (:func:`fault_parameters`).
 
 Each kind is one object (:class:`ActuatorKind`, :class:`SensorKind`) in the registries
 ``ACTUATOR_KINDS`` and ``SENSOR_KINDS``; identification, correction, isolation and units ask it
@@ -28,7 +31,8 @@ import casadi as ca
 from uvsym.errors import FaultError, IdentifiabilityError
 
 __all__ = ["PROFILES", "ACTUATOR_KINDS", "SENSOR_KINDS", "ActuatorKind", "SensorKind", "actuator_kind", "sensor_kind",
-           "Profile", "ActuatorFault", "SensorFault", "apply_actuator_faults", "apply_sensor_faults"]
+           "Profile", "ActuatorFault", "SensorFault", "apply_actuator_faults", "apply_sensor_faults",
+           "FAULT_PARAMETERS", "fault_parameters", "fault_shape", "symbolic_fault"]
 
 PROFILES = ("step", "ramp", "incipient", "intermittent")
 TIME_TOLERANCE = 1e-9  # s
@@ -200,7 +204,9 @@ class Profile:
         """True from onset until end (CasADi expression); a time within ``TIME_TOLERANCE`` of
         either counts as at it, so that a sample k dt that rounds just below an onset is in."""
         started = t - self.onset >= -TIME_TOLERANCE
-        return ca.logic_and(started, t < self.end - TIME_TOLERANCE) if math.isfinite(self.end) else started
+        if isinstance(self.end, numbers.Real) and math.isinf(self.end):
+            return started
+        return ca.logic_and(started, t < self.end - TIME_TOLERANCE)
 
     def phi(self, t):
         """phi(t) as a CasADi expression of t (SX/MX/DM or float)."""
@@ -264,6 +270,60 @@ class SensorFault:
     def kind_object(self) -> SensorKind:
         """The :class:`SensorKind` named by ``kind``."""
         return sensor_kind(self.kind)
+
+
+FAULT_PARAMETERS = ("value", "onset", "end", "duration", "rate", "period", "duty")
+_NEVER = 1.7976931348623157e308  # an end of inf, finite
+
+
+def fault_parameters(fault: ActuatorFault | SensorFault) -> tuple[float, ...]:
+    """The fault's numbers in the order of :data:`FAULT_PARAMETERS` (its value, its profile's times; an
+    end of never as the largest float, so that the numbers stay finite)."""
+    values = (fault.value,) + tuple(getattr(fault.profile, name) for name in FAULT_PARAMETERS[1:])
+    return tuple(min(float(v), _NEVER) for v in values)
+
+
+def fault_shape(fault: ActuatorFault | SensorFault) -> tuple:
+    """What a fault's symbolic injection depends on besides its numbers: (class, index, kind, profile kind)."""
+    index = fault.actuator if isinstance(fault, ActuatorFault) else fault.channel
+    return type(fault).__name__, index, fault.kind, fault.profile.kind
+
+
+@dataclass(frozen=True)
+class _SymbolicProfile:
+    """A :class:`Profile` whose times are CasADi symbols (validated as numbers before, per run)."""
+
+    kind: str
+    onset: ca.SX
+    end: ca.SX
+    duration: ca.SX
+    rate: ca.SX
+    period: ca.SX
+    duty: ca.SX
+
+    active = Profile.active
+    phi = Profile.phi
+
+
+@dataclass(frozen=True)
+class _SymbolicFault:
+    """A fault whose value and profile are symbols: what the ``apply_*`` functions read of a fault."""
+
+    actuator: int
+    channel: int
+    kind: str
+    value: ca.SX
+    profile: _SymbolicProfile
+    kind_object: ActuatorKind | SensorKind
+
+
+def symbolic_fault(shape: tuple, theta: ca.SX) -> _SymbolicFault:
+    """The fault of ``shape`` (:func:`fault_shape`) with the symbols theta (len(FAULT_PARAMETERS),) for its
+    numbers, in that order, for :func:`apply_actuator_faults` / :func:`apply_sensor_faults`."""
+    cls, index, kind, profile_kind = shape
+    profile = _SymbolicProfile(profile_kind, *(theta[i] for i in range(1, len(FAULT_PARAMETERS))))
+    kind_object = actuator_kind(kind) if cls == ActuatorFault.__name__ else sensor_kind(kind)
+    return _SymbolicFault(index, index, kind, theta[0], profile, kind_object)
 
 
 def _check_index_type(index, what: str) -> None:

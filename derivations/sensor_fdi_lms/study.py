@@ -39,8 +39,7 @@ from derivations.sensor_fdi_lms.design import (
 )
 from uvsym.faults import Profile, SensorFault
 from uvsym.observers.lms_supervisor import double_criterion
-from uvsym.sim.loop import sample_inputs
-from uvsym.sim.system_simulation import initial_state
+from uvsym.sim.system_simulation import initial_state, loop_inputs
 from uvsym.sim.wiring import interconnect
 
 __all__ = ["SEEDS", "SIZE_DEG", "EPS0_GRID_DEG2", "R0_GRID", "Study", "detection_study"]
@@ -80,9 +79,7 @@ def _records(pulse: bool) -> tuple[np.ndarray, np.ndarray]:
     eps2, R = np.empty((SEEDS, N)), np.empty((SEEDS, N))
     for i in range(SEEDS):
         seed = 1000 + i
-        W = sample_inputs(loop.n_w, N, DT, plant.y.size, seed)
-        W[:, loop.env_columns] = torque_table(N, seed)
-        W = np.ascontiguousarray(W[:N])
+        W = np.ascontiguousarray(loop_inputs(loop, N, torque_table(N, seed), seed)[:N])
         z0 = initial_state(loop, [math.radians(SET_POINT_DEG), 0.0], W[0])
         roll(z0, W, out)
         eps2[i], R[i] = out[:, columns[0]], out[:, columns[1]]

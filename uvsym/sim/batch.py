@@ -10,6 +10,12 @@ last bits; tests/test_batch.py). A run needing a supervisor (Python logic betwee
 run in lanes: :func:`simulate_batch` refuses one, and a scenario whose [diagnosis] corrects the
 commands, while it runs a diagnosis that only watches on the finished record, as
 :func:`simulate_scenario` does; :func:`simulate_scenario` runs the others.
+Scenarios over any System (:class:`~uvsym.sim.system_scenario.SystemScenario`) share a step when
+their plant, blocks, fault shapes (target, kind, profile kind), substitutions, step and substeps
+are the same (fault sizes, onsets, durations, noise levels, seeds, initial states and
+disturbances are per-run inputs, :mod:`uvsym.sim.wiring`); their detectors decide on each lane's
+finished record, as :func:`~uvsym.sim.system_scenario.simulate_system_scenario` does. One whose
+substitutions switch on a flag (a supervisor) is refused.
 Without a C compiler, or for a step the lanes cannot run, every run falls back to the scalar path
 (with a warning).
 """
@@ -36,9 +42,11 @@ __all__ = ["LANES", "simulate_batch", "run_lanes"]
 LANES = 4  # trajectories per compiled step: one AVX2 vector; 8 and 16 measured slower (benchmarks/campaign.py)
 
 
-def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substeps: int = 1, compiled: bool = True,
+def simulate_batch(scenarios: Sequence, *, lanes: int = LANES, substeps: int = 1, compiled: bool = True,
                    supervisor=None) -> list[SimResult]:
-    """Each scenario run as :func:`simulate_scenario` (method ``fast``) would, in lanes of shared compiled steps.
+    """Each scenario run as :func:`simulate_scenario` (method ``fast``; for a SystemScenario
+    :func:`~uvsym.sim.system_scenario.simulate_system_scenario`, whose own substeps hold) would, in
+    lanes of shared compiled steps.
 
     Scenarios share a loop when they share the model object (as loads of one file, or ``dataclasses.replace``
     of one scenario, do), have equal controllers, observers, sensor faults, step and duration;
@@ -54,10 +62,20 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
     if supervisor is not None:
         raise SimulationError("simulate_batch runs without a supervisor (no Python between the steps of the lanes); "
                               "run supervised scenarios with simulate_scenario")
+    from uvsym.sim.system_scenario import SystemScenario
+
     groups: dict[tuple, list[int]] = {}
+    systems: dict[tuple, list[int]] = {}
     for i, scenario in enumerate(scenarios):
+        if isinstance(scenario, SystemScenario):
+            if scenario.supervisor is not None:
+                raise SimulationError(f"scenarios[{i}] ({scenario.name}): its substitutions switch on a flag, a "
+                                      "supervisor the lanes cannot run; run it with simulate_system_scenario")
+            systems.setdefault((id(scenario.loop.step), scenario.duration), []).append(i)
+            continue
         if not isinstance(scenario, Scenario):
-            raise SimulationError(f"scenarios[{i}] must be a Scenario, got {type(scenario).__name__}")
+            raise SimulationError(f"scenarios[{i}] must be a Scenario or a SystemScenario, got "
+                                  f"{type(scenario).__name__}")
         if scenario.diagnosis is not None and scenario.diagnosis.correct:
             raise SimulationError(f"scenarios[{i}] ({scenario.name}): its [diagnosis] corrects the commands, a "
                                   "supervisor the lanes cannot run; run it with simulate_scenario")
@@ -78,7 +96,25 @@ def simulate_batch(scenarios: Sequence[Scenario], *, lanes: int = LANES, substep
             if scenarios[i].diagnosis is not None:
                 meta["events"] = _diagnosed(scenarios[i], result)
             results[i] = SimResult(result.t, result.signals, meta)
+    for members in systems.values():
+        for i, result in zip(members, _system_lanes([scenarios[i] for i in members], lanes, compiled)):
+            results[i] = result
     return results
+
+
+def _system_lanes(scenarios: list, lanes: int, compiled: bool) -> list[SimResult]:
+    """Scenarios over one shared wired step, in lanes; each result as simulate_system_scenario gives it."""
+    from uvsym.sim.system_scenario import decided, scenario_meta_arguments
+    from uvsym.sim.system_simulation import loop_inputs, wired_meta
+
+    runs = []
+    for scenario in scenarios:
+        N = round(scenario.duration / scenario.step)
+        meta = wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario))
+        runs.append(PreparedRun(scenario.loop, scenario.z0, loop_inputs(scenario.loop, N, scenario.d, scenario.seed),
+                                None, meta))
+    results = run_lanes(runs, lanes=lanes, compiled=compiled, names=[s.name for s in scenarios])
+    return [decided(scenario, result) for scenario, result in zip(scenarios, results)]
 
 
 def _diagnosed(scenario: Scenario, result: SimResult) -> list[dict]:
@@ -93,7 +129,8 @@ def _diagnosed(scenario: Scenario, result: SimResult) -> list[dict]:
 
 def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool = True,
               names: Sequence[str] | None = None) -> list[SimResult]:
-    """Runs prepared on ONE shared loop (:func:`prepare_run` with ``loop=``) and the same grid, ``lanes`` at a time.
+    """Runs prepared on ONE shared loop step (:func:`prepare_run` with ``loop=``, or wired loops of one
+    shape) and the same grid, ``lanes`` at a time.
 
     Returns one SimResult per run (meta: the run's, ``lanes``, ``wall_s`` and ``build_s`` of the
     batch). ``names`` label the runs in errors (default: their index). Falls back to one scalar run
@@ -103,7 +140,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool
         return []
     loop, N = runs[0].loop, runs[0].W.shape[0] - 1
     for i, run in enumerate(runs):
-        if run.loop is not loop or run.W.shape != runs[0].W.shape:
+        if run.loop.step is not loop.step or run.W.shape != runs[0].W.shape:
             raise SimulationError(f"run {i} does not share the first run's loop and grid; prepare them with one loop")
     names = [str(i) for i in range(len(runs))] if names is None else list(names)
     started = time.perf_counter()

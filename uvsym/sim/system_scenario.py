@@ -181,7 +181,14 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
 
 
 def _setpoint(fields: Fields, plant: System) -> Block:
-    """A [[setpoints]] table: the schedule of one signal, as the block ``setpoint_<signal>``."""
+    """A [[setpoints]] table: the schedule of one signal, as the block ``setpoint_<signal>``; memoized by
+    the table's content (as catalogue blocks are), so that the runs of a campaign share their loop."""
+    return _setpoint_block(fields.data, fields.path, plant)
+
+
+@memoized(64)
+def _setpoint_block(data: dict, path: str, plant: System) -> Block:
+    fields = Fields(data, path)
     signal = fields.text("signal")
     block = schedule(fields, plant, f"setpoint_{signal}", (signal,))
     fields.done()
@@ -343,10 +350,20 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     N = round(scenario.duration / scenario.step)
     W = loop_inputs(scenario.loop, N, scenario.d, scenario.seed)
     result = run_wired(scenario.loop, scenario.z0, W, method=method, supervisor=scenario.supervisor,
-                       options=options, compiled=compiled, progress=progress, duration=scenario.duration,
-                       seed=scenario.seed, actuator_faults=scenario.actuator_faults,
-                       sensor_faults=scenario.sensor_faults,
-                       substitutions=scenario.substitutions)
+                       options=options, compiled=compiled, progress=progress, **scenario_meta_arguments(scenario))
+    return decided(scenario, result)
+
+
+def scenario_meta_arguments(scenario: SystemScenario) -> dict:
+    """The keyword arguments of :func:`~uvsym.sim.system_simulation.wired_meta` (and ``run_wired``) a
+    scenario's run describes itself with: duration, seed, faults, substitutions."""
+    return {"duration": scenario.duration, "seed": scenario.seed, "actuator_faults": scenario.actuator_faults,
+            "sensor_faults": scenario.sensor_faults, "substitutions": scenario.substitutions}
+
+
+def decided(scenario: SystemScenario, result: SimResult) -> SimResult:
+    """``result`` with every detector's decisions on the finished record in its meta: ``events`` in time
+    order (each names its ``detector``), ``detectors`` each detector's design; ``scenario`` its name."""
     events = sorted((e for detector in scenario.detectors for e in detector.decide(result)), key=lambda e: e.t)
     meta = {"scenario": scenario.name, **result.meta, "events": [e.as_dict() for e in events],
             "detectors": [detector.design() for detector in scenario.detectors]}

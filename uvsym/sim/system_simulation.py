@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 
 from uvsym.errors import SimulationError
-from uvsym.faults import ActuatorFault, SensorFault
+from uvsym.faults import ActuatorFault, SensorFault, fault_parameters
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
-__all__ = ["simulate_system", "initial_state", "loop_inputs", "run_wired"]
+__all__ = ["simulate_system", "initial_state", "loop_inputs", "run_wired", "wired_meta"]
 
 
 def initial_state(loop: WiredLoop, x0, w0: np.ndarray) -> np.ndarray:
@@ -76,11 +76,14 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
 
 def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0) -> np.ndarray:
     """W (N + 1, n_w) of a wired loop: times, seeded noise draws, disturbances d (constant (n_d,) or one
-    row per sample; default 0), substitution switches off. SimulationError when it cannot be held."""
+    row per sample; default 0), the numbers of the loop's faults, substitution switches off.
+    SimulationError when it cannot be held."""
     plant = loop.plant
     check_memory(memory_needed(N + 1, loop), f"{N * loop.dt:g} s at step {loop.dt:g} s ({N + 1} samples)")
-    W = sample_inputs(loop.n_w, N, loop.dt, plant.y.size, seed)  # one row per sample: [t, noise, d, switches]
-    W[:, loop.env_columns] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
+    W = sample_inputs(loop.n_w, N, loop.dt, plant.y.size, seed)  # one row per sample: [t, noise, d, theta, switches]
+    start = loop.env_columns.start
+    W[:, start:start + plant.d.size] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
+    W[:, loop.fault_columns] = [value for fault in loop.faults for value in fault_parameters(fault)]
     return W
 
 
@@ -90,12 +93,20 @@ def run_wired(loop: WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "
               substitutions=None) -> SimResult:
     """Run a wired loop from z0 over the rows of W (:func:`loop_inputs`); the result of :func:`simulate_system`
     (the faults and substitutions given only describe the loop's own in the result's meta)."""
-    plant = loop.plant
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
                                      compiled=compiled, progress=progress)
-    meta = {"plant": plant.name, "method": method, "dt_s": loop.dt, "duration_s": duration,
+    meta = wired_meta(loop, method=method, duration=duration, seed=seed, actuator_faults=actuator_faults,
+                      sensor_faults=sensor_faults, substitutions=substitutions)
+    return SimResult(result.t, result.signals, meta | timing)
+
+
+def wired_meta(loop: WiredLoop, *, method: str, duration: float, seed: int, actuator_faults=(), sensor_faults=(),
+               substitutions=None) -> dict:
+    """The meta of a wired loop's result (no timings): plant, method, dt_s, duration_s, substeps, seed,
+    blocks, order, substitutions and the faults (target by name, kind, value, profile, onset_s, end_s)."""
+    plant = loop.plant
+    return {"plant": plant.name, "method": method, "dt_s": loop.dt, "duration_s": duration,
             "substeps": loop.substeps, "seed": seed, "blocks": [b.name for b in loop.blocks],
             "order": list(loop.order), "substitutions": dict(substitutions or {}),
             "actuator_faults": [fault_summary(f, plant.u.names[f.actuator]) for f in actuator_faults],
-            "sensor_faults": [fault_summary(f, plant.y.names[f.channel]) for f in sensor_faults], **timing}
-    return SimResult(result.t, result.signals, meta)
+            "sensor_faults": [fault_summary(f, plant.y.names[f.channel]) for f in sensor_faults]}

@@ -12,8 +12,12 @@ published, never substituted (unless some block publishes ``N.raw`` itself).
 
 State ``z = [x (n_x); s of each block, in order; held (n_y)]``: plant state, block states, and
 the outputs latched at the last sample before a stuck sensor fault. Per-sample input
-``w = [t; noise (n_y); d (n_d); on (n_c)]``: time (s), standard normal draws for sensor noise,
-the plant's disturbances, and one switch (0 or 1) per substitution channel. At each sample
+``w = [t; noise (n_y); d (n_d); theta (7 per fault); on (n_c)]``: time (s), standard normal draws
+for sensor noise, the plant's disturbances, each fault's numbers (value and profile times,
+:func:`uvsym.faults.fault_parameters`, constant over a run) and one switch (0 or 1) per
+substitution channel. The loop's Functions depend on its faults' shapes only (target, kind,
+profile kind), so runs that differ in fault sizes, onsets and durations share one compiled step
+(and its lanes); :func:`interconnect` makes the loop of one shape once per process. At each sample
 
     y_k = h(x_k, u_f(u_k, t_k), p) + sensor faults,     blocks: s_{k+1}, out_k = step(s_k, r_k)
 
@@ -32,13 +36,22 @@ from __future__ import annotations
 
 import difflib
 import graphlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import casadi as ca
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.errors import WiringError
-from uvsym.faults import ActuatorFault, SensorFault, apply_actuator_faults, apply_sensor_faults
+from uvsym.faults import (
+    FAULT_PARAMETERS,
+    ActuatorFault,
+    SensorFault,
+    apply_actuator_faults,
+    apply_sensor_faults,
+    fault_shape,
+    symbolic_fault,
+)
 from uvsym.sim.blocks import Block
 from uvsym.sim.loop import SampledLoop, logged_signals
 from uvsym.symbolic import rk4
@@ -55,10 +68,12 @@ RAW = ".raw"
 @dataclass(frozen=True, kw_only=True)
 class WiredLoop(SampledLoop):
     """A loop of a System and blocks (the runner's fields in :class:`~uvsym.sim.loop.SampledLoop`):
-    s = x, env = d; z = [x; each block's state; held]. reads(z, w) -> what each block reads, one
-    output per block (named by it); names: the published signals; units: name -> unit; order:
+    s = x, env = [d; theta]; z = [x; each block's state; held]. reads(z, w) -> what each block reads,
+    one output per block (named by it); names: the published signals; units: name -> unit; order:
     their evaluation order; layout: x, each block's name, held -> slice; substitution_columns:
-    channel -> the column of w holding its switch; no command correction.
+    channel -> the column of w holding its switch; no command correction. faults: the actuator
+    then sensor faults whose numbers :func:`~uvsym.sim.system_simulation.loop_inputs` writes in the
+    ``fault_columns`` of w (another run of the same shapes gives its own).
     """
 
     plant: System
@@ -68,6 +83,8 @@ class WiredLoop(SampledLoop):
     names: tuple[str, ...]
     units: dict[str, str]
     order: tuple[str, ...]
+    faults: tuple = ()
+    fault_columns: slice = field(default_factory=lambda: slice(0, 0))
 
 
 def _column(items) -> ca.SX:
@@ -226,8 +243,19 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     """
     blocks = tuple(blocks)
     _check(plant, blocks, dt, substeps)
-    p = ca.DM(plant.p.vector(plant.p0 if p is None else p, f"{plant.name}: parameters p"))
-    substitutions = dict(substitutions or {})
+    p = tuple(plant.p.vector(plant.p0 if p is None else p, f"{plant.name}: parameters p"))
+    faults = tuple(actuator_faults) + tuple(sensor_faults)
+    shapes = tuple(fault_shape(f) for f in faults)
+    loop = _wired(plant, blocks, float(dt), shapes, tuple(dict(substitutions or {}).items()), substeps, p)
+    return replace(loop, faults=faults)
+
+
+@memoized(32)
+def _wired(plant: System, blocks: tuple[Block, ...], dt: float, shapes: tuple, substitutions: tuple,
+           substeps: int, p: tuple) -> WiredLoop:
+    """The loop of :func:`interconnect` for faults of these shapes, their numbers symbols of w."""
+    p = ca.DM(p)
+    substitutions = dict(substitutions)
     raw = [f"{c!r} -> {s!r}" for c, s in substitutions.items() if c.endswith(RAW) or s.endswith(RAW)]
     if raw:
         raise WiringError(f"substitutions {', '.join(raw)}: a substitution joins two published signals; "
@@ -251,10 +279,14 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
     layout, start = {}, 0
     for part, size in [("x", n_x)] + [(b.name, b.state.size) for b in blocks] + [("held", n_y)]:
         layout[part], start = slice(start, start + size), start + size
-    n_z, n_w = start, 1 + n_y + n_d + n_c
+    n_theta = len(FAULT_PARAMETERS) * len(shapes)
+    n_env = n_d + n_theta
+    n_z, n_w = start, 1 + n_y + n_env + n_c
     z, w = ca.SX.sym("z", n_z), ca.SX.sym("w", n_w)
     x, held, t = z[layout["x"]], z[layout["held"]], w[0]
-    noise, d, on = w[1:1 + n_y], w[1 + n_y:1 + n_y + n_d], w[1 + n_y + n_d:]
+    noise, env_w, on = w[1:1 + n_y], w[1 + n_y:1 + n_y + n_env], w[1 + n_y + n_env:]
+    d = env_w[:n_d]
+    actuator_faults, sensor_faults = _symbolic_faults(shapes, env_w[n_d:])
     switch = {channel: (on[i], substitute) for i, (channel, substitute) in enumerate(pairs)}
     P = {name: ca.SX.sym(name) for name in published.who}
 
@@ -301,14 +333,24 @@ def interconnect(plant: System, blocks, *, dt: float, actuator_faults: tuple[Act
         plant_ode = None
         x_next = plant.f(x, apply_actuator_faults(u_cmd, t, actuator_faults), d, p)
     else:
-        s, uc, env, ts = ca.SX.sym("s", n_x), ca.SX.sym("u_cmd", plant.u.size), ca.SX.sym("env", n_d), ca.SX.sym("t")
-        s_dot = plant.f(s, apply_actuator_faults(uc, ts, actuator_faults), env, p)
+        s, uc, env, ts = ca.SX.sym("s", n_x), ca.SX.sym("u_cmd", plant.u.size), ca.SX.sym("env", n_env), ca.SX.sym("t")
+        ode_faults = _symbolic_faults(shapes, env[n_d:])[0]
+        s_dot = plant.f(s, apply_actuator_faults(uc, ts, ode_faults), env[:n_d], p)
         plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot], ["s", "u_cmd", "env", "t"], ["s_dot"])
-        x_next = rk4(plant_ode, x, dt, substeps, u_cmd, d, t=t)
+        x_next = rk4(plant_ode, x, dt, substeps, u_cmd, env_w, t=t)
     step = ca.Function("wired_loop_step", [z, w], [ca.densify(ca.vertcat(x_next, z_disc)), out], ["z", "w"],
                        ["z_next", "out"], {"cse": True})
     return WiredLoop(plant=plant, blocks=blocks, p=np.asarray(p).ravel(), dt=float(dt), substeps=substeps, n_z=n_z,
                      n_w=n_w, n_s=n_x, discrete=discrete, plant_ode=plant_ode, step=step, reads=reads,
                      names=names, units=units, order=tuple(order), layout=layout, signals=signals,
-                     env_columns=slice(1 + n_y, 1 + n_y + n_d),
-                     substitution_columns={channel: 1 + n_y + n_d + i for i, channel in enumerate(substitutions)})
+                     env_columns=slice(1 + n_y, 1 + n_y + n_env),
+                     fault_columns=slice(1 + n_y + n_d, 1 + n_y + n_env),
+                     substitution_columns={channel: 1 + n_y + n_env + i for i, channel in enumerate(substitutions)})
+
+
+def _symbolic_faults(shapes: tuple, theta: ca.SX) -> tuple[tuple, tuple]:
+    """(actuator faults, sensor faults) of these shapes with their numbers the consecutive entries of theta."""
+    size = len(FAULT_PARAMETERS)
+    faults = [symbolic_fault(shape, theta[size * i:size * (i + 1)]) for i, shape in enumerate(shapes)]
+    return (tuple(f for f, shape in zip(faults, shapes) if shape[0] == ActuatorFault.__name__),
+            tuple(f for f, shape in zip(faults, shapes) if shape[0] != ActuatorFault.__name__))
