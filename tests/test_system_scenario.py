@@ -203,6 +203,8 @@ set = {{ duration = 4.0, faults = [] }}
     for figures in summary["detectors"].values():
         assert figures["detection_probability"] == 0.5 and figures["missed_detections"] == 1
         assert figures["healthy_hours"] == pytest.approx((4.0 + 3.0 + 3.0) / 3600)
+        assert 0 < figures["decision_cpu_s_per_simulated_hour"] < figures["wall_s_per_simulated_hour"]
+    assert all(r["luenberger_fd:decision_cpu_s"] > 0 for r in rows)
     assert "## Detectors side by side" in (tmp_path / "out" / "report.md").read_text()
 
 

@@ -136,7 +136,9 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
 def run_metrics(scenario, result, events: list[dict]) -> dict:
     """:func:`truth`, :func:`event_metrics`, duration_s (simulated s), path_error_rms_m (RMS of the
     reference's cross-track error over the run, m; None when the result has none) and, per
-    detector D, ``D:<metric>`` for each of :data:`DETECTOR_COLUMNS` (module docstring)."""
+    detector D, ``D:<metric>`` for each of :data:`DETECTOR_COLUMNS` (module docstring) and
+    ``D:decision_cpu_s``, the processor time D took to decide on the record (s; None where the
+    decisions are made in the loop)."""
     true = truth(scenario)
     reference = result.signals.get("reference")
     rms = None
@@ -149,4 +151,5 @@ def run_metrics(scenario, result, events: list[dict]) -> dict:
         for name in names:
             own = event_metrics(true, [e for e in events if e.get("detector") == name])
             row |= {f"{name}:{column}": own[column] for column in DETECTOR_COLUMNS}
+            row[f"{name}:decision_cpu_s"] = result.meta.get("detector_cpu_s", {}).get(name)
     return row
