@@ -275,6 +275,24 @@ def _check_events_path(path, scenario, force: bool) -> None:
         raise UvsymError(f"--events: {path} exists; pass --force to overwrite it")
 
 
+def _read_system_scenario(source: str, command: str):
+    """(scenario, table) of a scenario file over a System, for ``uvsym codegen`` and ``uvsym verify``."""
+    from uvsym.errors import ScenarioError
+    from uvsym.sim.scenario import read_scenario_file
+    from uvsym.sim.system_scenario import is_system_scenario, parse_system_scenario
+
+    path = _scenario_path(source)
+    table = read_scenario_file(path)
+    if not is_system_scenario(table):
+        raise ScenarioError(f"uvsym {command} {source}: a vehicle scenario (no 'plant'); {command} takes scenarios "
+                            f"over a plant (the observer sets of vehicles: uvsym {command} --help)")
+    return parse_system_scenario(table, default_name=path.stem, root=path.parent), table
+
+
+def _is_scenario_file(name: str) -> bool:
+    return name.endswith(".toml")
+
+
 def _cmd_codegen(args) -> int:
     from uvsym.codegen.observer_sets import option_flags, options_of
 
@@ -285,10 +303,20 @@ def _cmd_codegen(args) -> int:
         return 0
     if not args.out:
         raise UvsymError(f"uvsym codegen {args.name}: give the output folder with -o/--out DIR")
-    factory = observer_sets().get(args.name, (None, None))[1]
-    options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
-    options |= _set_options(args.name, factory, args.set_options)
-    observers = observer_set(args.name, **options)
+    if _is_scenario_file(args.name):
+        from uvsym.scenario_exports import scenario_package
+
+        if args.set_options or args.vehicle or args.form:
+            raise UvsymError(f"uvsym codegen {args.name}: --vehicle, --form and set options are for observer sets; "
+                             "a scenario's blocks take their design from the file")
+        scenario, _ = _read_system_scenario(args.name, "codegen")
+        names = None if args.blocks is None else [n.strip() for n in args.blocks.split(",") if n.strip()]
+        observers = scenario_package(scenario, names)
+    else:
+        factory = observer_sets().get(args.name, (None, None))[1]
+        options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
+        options |= _set_options(args.name, factory, args.set_options)
+        observers = observer_set(args.name, **options)
     make_folder(claim_folder(args.out, "the C package", "package", args.force), "the C package")
     manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check)
     count = len(manifest["functions"])
@@ -348,21 +376,34 @@ def _cmd_verify(args) -> int:
     from uvsym.report.markdown import write_json
     from uvsym.verify.certificate import STATUSES
 
+    scenario_files = [n for n in args.names if _is_scenario_file(n)]
+    studies = [n for n in args.names if not _is_scenario_file(n)]
     everything, failures = [], 0
-    for study in (s for s in _selected(args.names) if s.claims is not None):
-        name = study.name
-        started = time.perf_counter()
-        certificates = study.claims()
+
+    def record(name: str, certificates, seconds: float, notes=()) -> None:
+        nonlocal failures
         rows = [c.to_dict() for c in certificates]
         failures += sum(not c.as_expected for c in certificates)
         out_dir = output_folder(args.out, "proofs") / name
         out_dir.mkdir(parents=True, exist_ok=True)
         write_json(out_dir / "proofs.json", [{**row, "seconds": round(row["seconds"], 3)} for row in rows])
-        everything += [{"derivation": name, **row} for row in rows]
+        everything.extend({"derivation": name, **row} for row in rows)
         if not args.json:
-            print(f"{name}: {len(rows)} claims in {time.perf_counter() - started:.1f} s, written to\n"
-                  f"  {out_dir / 'proofs.json'}")
+            print(f"{name}: {len(rows)} claims in {seconds:.1f} s, written to\n  {out_dir / 'proofs.json'}")
             print("\n\n".join(_claim_block(r) for r in rows) + "\n")
+            print("".join(f"   {note}\n" for note in notes))
+
+    if studies or not scenario_files:
+        for study in (s for s in _selected(studies) if s.claims is not None):
+            started = time.perf_counter()
+            record(study.name, study.claims(), time.perf_counter() - started)
+    for source in scenario_files:
+        from uvsym.scenario_exports import scenario_claims
+
+        started = time.perf_counter()
+        scenario, table = _read_system_scenario(source, "verify")
+        certificates, notes = scenario_claims(scenario, table)
+        record(scenario.name, certificates, time.perf_counter() - started, notes)
     if args.json:
         print(json.dumps(everything, indent=2))
     else:
@@ -420,6 +461,7 @@ def _parser() -> argparse.ArgumentParser:
         epilog="examples:\n  uvsym models show remus100\n  uvsym simulate docking_faults --out run.npz --plot\n"
                "  uvsym report actuator-observers\n  uvsym verify --json\n"
                "  uvsym codegen actuator-observers -o c_out --vehicle otter3dof\n"
+               "  uvsym codegen examples/dc_motor/speed_sensor_bias.toml -o c_motor --blocks luenberger\n"
                "  uvsym campaign examples/campaign_docking.toml --workers 2\n"
                "'uvsym COMMAND --help' gives each command's options.")
     parser.add_argument("--version", action="version", version=f"uvsym {__version__}")
@@ -451,7 +493,10 @@ def _parser() -> argparse.ArgumentParser:
     simulate.set_defaults(run=_cmd_simulate)
     codegen = sub.add_parser("codegen", help="write a C99 package of an observer set (sources, build files, manifest); "
                                              "a set's own options as --name value (uvsym codegen --list)")
-    codegen.add_argument("name", nargs="?", help="observer set a derivation declares (none: list them)")
+    codegen.add_argument("name", nargs="?", help="observer set a derivation declares, or a scenario file over a "
+                                                 "plant (FILE.toml: its blocks' steps); none: list the sets")
+    codegen.add_argument("--blocks", help="with a scenario file: the blocks to export, comma-separated "
+                                          "(default: every block with a state)")
     codegen.add_argument("-o", "--out", help="output folder (needed with a set)")
     codegen.add_argument("--list", action="store_true", help="list the observer sets with their derivation")
     codegen.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
@@ -476,7 +521,8 @@ def _parser() -> argparse.ArgumentParser:
     campaign.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
     campaign.set_defaults(run=_cmd_campaign)
     verify = sub.add_parser("verify", help="check the derivations' claims by machine; exit 1 if any is unexpected")
-    verify.add_argument("names", nargs="*", help="derivations (default: all that make claims)")
+    verify.add_argument("names", nargs="*", help="derivations, or scenario files over a plant (FILE.toml: claims "
+                                                 "about its estimators); default: every derivation that makes claims")
     verify.add_argument("--json", action="store_true", help="print the claims as a JSON list")
     verify.add_argument("--out", default="reports", help="where proofs.json goes, beside the report (default reports)")
     verify.set_defaults(run=_cmd_verify)

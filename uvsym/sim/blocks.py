@@ -36,7 +36,8 @@ class Block:
     state, reads, publishes: the Signals of s, r and out (reads and publishes are loop signal
     names); s0: (n_s,) initial state; dt: the sample period (s) the step was designed for, None
     for a block valid at any rate; init(r0 (n_r,)) -> s0: the initial state from the first
-    sample's reads, or None to start at s0.
+    sample's reads, or None to start at s0; source: the Observer the block runs (for claims about
+    it, :mod:`uvsym.scenario_exports`), None for other blocks.
     """
 
     name: str
@@ -48,6 +49,7 @@ class Block:
     dt: float | None = None
     init: Callable | None = None
     description: str = ""
+    source: object = None
 
     def __post_init__(self):
         check_name(self.name, "block", WiringError)
@@ -87,7 +89,7 @@ def as_signals(spec: str | Sequence[str] | Signals, group: str) -> Signals:
 
 
 def block(name: str, *, step: Callable, state: Signals | None = None, reads=(), publishes=(), s0=None,
-          dt: float | None = None, init: Callable | None = None, description: str = "") -> Block:
+          dt: float | None = None, init: Callable | None = None, description: str = "", source=None) -> Block:
     """A Block from a Python callable ``step(s, r) -> (s_next, out)`` on SX column vectors.
 
     reads, publishes: Signals, names or one name; state: Signals (default none); s0 default zeros.
@@ -102,7 +104,7 @@ def block(name: str, *, step: Callable, state: Signals | None = None, reads=(), 
     s_next, out = (ca.densify(ca.vec(ca.SX(v))) for v in result)
     function = ca.Function(f"{name}_step", [s, r], [s_next, out], list(STEP_INPUTS), list(STEP_OUTPUTS))
     return Block(name, state, reads, publishes, function, np.zeros(state.size) if s0 is None else s0, dt, init,
-                 description)
+                 description, source)
 
 
 def renamed(blk: Block, reads: dict[str, str] | None = None, publishes: dict[str, str] | None = None) -> Block:
@@ -134,7 +136,7 @@ def observer_block(obs: Observer, p=None, *, s0=None) -> Block:
 
     return block(obs.name, step=lambda s, r: obs.step(s, r[:n_y], r[n_y:], ca.DM(p)), state=obs.state,
                  reads=obs.reads_y + obs.reads_u, publishes=obs.publishes, s0=s0, dt=obs.dt, init=init,
-                 description=obs.description)
+                 description=obs.description, source=obs)
 
 
 def select(name: str, *, flag: str, on: str | Sequence[str], off: str | Sequence[str], output: str | Sequence[str],
