@@ -74,6 +74,29 @@ def test_readme_scenario_schema_is_the_validators():
     assert block == schema_markdown(), "README's schema is stale: paste the output of uvsym simulate --schema"
 
 
+def test_readme_plant_scenario_schema_is_the_validators():
+    from uvsym.sim.schema import schema_markdown
+
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index("<!-- plant-scenario-schema -->") + len("<!-- plant-scenario-schema -->"):
+                   readme.index("<!-- /plant-scenario-schema -->")].strip()
+    assert block == schema_markdown("plant"), "README's plant schema is stale: paste uvsym simulate --schema plant"
+
+
+def test_the_plant_schema_is_generic_and_gives_each_block_type_its_fields():
+    from uvsym.sim.schema import scenario_schema
+
+    fields = {row["field"]: row for row in scenario_schema("plant")}
+    assert fields["blocks[pid].kp"]["default"] == "required" and fields["blocks[pid].limits"]["default"] == "none"
+    assert fields["blocks[lqr].q"]["rule"].startswith("n_x x n_x")
+    assert fields["initial.x"]["default"] == "the plant's operating point"
+    assert fields["detectors[threshold].false_alarms_per_hour"]["rule"] == "> 0"
+    text = " ".join(str(v) for row in fields.values() for v in row.values())
+    for specific in ("quadrotor", "rov_yaw", "/", "phi"):   # nothing of one plant or one machine's paths
+        assert specific not in text.replace("n_x x n_x", "").replace("[lo, hi]", "") or specific == "/", specific
+    assert "/work" not in text and "site-packages" not in text
+
+
 def test_the_schema_names_every_field_a_shipped_scenario_uses_and_the_rules():
     from uvsym.sim.schema import scenario_schema
 

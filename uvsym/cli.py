@@ -140,13 +140,12 @@ def _cmd_report(args) -> int:
 
 def _scenario_path(source: str) -> Path:
     """A scenario file, or the file of a shipped scenario (uvsym's or a derivation's) named ``source``."""
-    from uvsym.derivation import study_scenarios
-    from uvsym.sim.scenario import shipped_scenarios
+    from uvsym.sim.scenario import every_shipped_scenario
 
     path = Path(source)
     if path.exists():
         return path
-    shipped = {**shipped_scenarios(), **{name: file for name, (_, file) in study_scenarios().items()}}
+    shipped = every_shipped_scenario()
     if source not in shipped:
         raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
                                f"shipped: {', '.join(sorted(shipped))}")
@@ -185,10 +184,11 @@ def _cmd_simulate(args) -> int:
     if args.schema:
         from uvsym.sim.schema import schema_markdown
 
-        print(schema_markdown())
+        print(schema_markdown(args.schema))
         return 0
     if args.list or not args.scenario:
         rows = [[name, "", str(path.name)] for name, path in shipped_scenarios().items()]
+        rows += [[name, "", f"plants/{path.name}"] for name, path in shipped_scenarios("plant").items()]
         rows += [[name, study, str(path.name)] for name, (study, path) in study_scenarios().items()]
         print(_table(rows, ["shipped scenario", "study", "file"]))
         return 0
@@ -486,8 +486,9 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", nargs="?", const="", default=None,
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
-    simulate.add_argument("--schema", action="store_true", help="print every field of a vehicle scenario file "
-                                                                "(type, default, rule) as a Markdown table")
+    simulate.add_argument("--schema", nargs="?", const="vehicle", choices=["vehicle", "plant"],
+                          help="print every field of a vehicle scenario file, or (plant) of a scenario over a "
+                               "plant (type, default, rule) as a Markdown table")
     simulate.add_argument("--events", help="write the diagnosis's decision log (.json; needs a [diagnosis] table)")
     simulate.add_argument("--force", action="store_true", help="overwrite an existing --out, --plot or --events file")
     simulate.set_defaults(run=_cmd_simulate)

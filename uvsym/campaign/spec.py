@@ -36,7 +36,7 @@ import numpy as np
 from uvsym.campaign.dotted import flatten, parse_path, set_path
 from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError
 from uvsym.sim.fields import Fields
-from uvsym.sim.scenario import read_scenario_file, shipped_scenarios
+from uvsym.sim.scenario import every_shipped_scenario, read_scenario_file
 from uvsym.sim.system_scenario import is_system_scenario, parse_any_scenario
 
 __all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS"]
@@ -192,14 +192,9 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
     source = fields.text("scenario")
     path = root / source
     if not path.is_file():
-        shipped = shipped_scenarios()
+        shipped = every_shipped_scenario()
         if source not in shipped:
-            from uvsym.derivation import study_scenarios
-
-            study = study_scenarios().get(source)
-            kind = (f" ({source!r} is a scenario of the {study[0]} study, whose experiments do not run in campaigns "
-                    "yet)" if study else "")
-            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}{kind}; "
+            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}; "
                                 f"shipped: {', '.join(shipped)}")
         path = shipped[source]
     try:

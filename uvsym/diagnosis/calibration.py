@@ -60,14 +60,15 @@ def residual_covariance(loop, z0: np.ndarray, w0: np.ndarray, names: tuple[str, 
     S, A_j = B @ B.T, A
     previous = C @ S @ C.T + D @ D.T
     for _ in range(_DOUBLINGS):
-        S = S + A_j @ S @ A_j.T
-        A_j = A_j @ A_j
-        current = C @ S @ C.T + D @ D.T
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverging sum is refused below
+            S = S + A_j @ S @ A_j.T
+            A_j = A_j @ A_j
+            current = C @ S @ C.T + D @ D.T
         if not np.all(np.isfinite(current)):
             break
         if np.allclose(current, previous, rtol=1e-12, atol=0.0):
             return current
         previous = current
-    raise DiagnosisError(f"the noise variance of {', '.join(names)} does not settle: the loop linearised at its "
-                         "initial state is unstable in a mode the sensor noise excites (stabilise the loop, or state "
-                         "the residuals' standard deviations in the detector's std field)")
+    raise DiagnosisError(f"the noise variance of {', '.join(names)} does not settle: the loop linearised at "
+                         "the calibration point is unstable in a mode the sensor noise excites (stabilise the loop, "
+                         "or state the residuals' standard deviations in the detector's std field)")

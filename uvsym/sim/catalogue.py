@@ -36,10 +36,12 @@ from uvsym.systems.system import System
 __all__ = ["BLOCKS", "build_block", "schedule"]
 
 
-def _matrix(fields: Fields, key: str, shape: tuple[int, int], default=None, *, diagonal: bool = True) -> np.ndarray:
-    """A (rows, cols) matrix: a full list of rows, or (square, ``diagonal``) a number or the diagonal."""
-    fields._record(key, "number, list or matrix", default, f"{shape[0]} x {shape[1]}" + (", or its diagonal"
-                                                                                          if diagonal else ""))
+def _matrix(fields: Fields, key: str, shape: tuple[int, int], dims: str, default=None, *,
+            diagonal: bool = True) -> np.ndarray:
+    """A (rows, cols) matrix: a full list of rows, or (square, ``diagonal``) a number or the diagonal;
+    ``dims`` names its shape for the schema (``n_x x n_x``)."""
+    fields._record(key, "number, list or matrix", default, dims + (", or a number, or its diagonal" if diagonal
+                                                                    else ""))
     fields.used.add(key)
     value = fields.data.get(key, default)
     if value is None:
@@ -88,7 +90,7 @@ def _pid(fields: Fields, plant: System, dt: float, name: str) -> Block:
     reference = fields.raw("reference", 0.0, "number or signal name", "set-point (measured's unit)")
     if not isinstance(reference, str):
         reference = Fields({"reference": reference}, fields.path).number("reference")
-    limits = fields.raw("limits", None, "[lo, hi]", "output bounds (output's unit)")
+    limits = fields.raw("limits", None, "[lo, hi]", "output bounds (output's unit)", "none")
     if limits is not None:
         limits = tuple(Fields({"limits": limits}, fields.path).vector("limits", 2))
     gains = {key: fields.number(key, 0.0 if key != "kp" else None) for key in ("kp", "ki", "kd")}
@@ -99,21 +101,29 @@ def _pid(fields: Fields, plant: System, dt: float, name: str) -> Block:
 def _state_feedback(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.sim.feedback import state_feedback
 
+    _plant_defaults(fields)
     reads = _names(fields, "reads", plant.x.names)
     publishes = _names(fields, "publishes", plant.u.names)
-    K = _matrix(fields, "gain", (len(publishes), len(reads)), diagonal=False)
+    K = _matrix(fields, "gain", (len(publishes), len(reads)), "publishes x reads", diagonal=False)
     return state_feedback(name, K, _group(plant, reads, fields.path, "read"),
                           fields.vector("x_ref", len(reads)), fields.vector("u_ref", len(publishes)),
                           _group(plant, publishes, fields.path, "published"))
 
 
+def _plant_defaults(fields: Fields) -> None:
+    """Describe, for the schema, the reads and publishes that default to the plant's states and inputs."""
+    fields.describe("reads", "string or list of strings", "loop signal names", "the plant's states")
+    fields.describe("publishes", "string or list of strings", "loop signal names", "the plant's inputs")
+
+
 def _lqr(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.sim.feedback import lqr
 
+    _plant_defaults(fields)
     reads = _names(fields, "reads", plant.x.names, size=plant.x.size)
     publishes = _names(fields, "publishes", plant.u.names, size=plant.u.size)
-    Q = _matrix(fields, "q", (plant.x.size,) * 2)
-    R = _matrix(fields, "r", (plant.u.size,) * 2)
+    Q = _matrix(fields, "q", (plant.x.size,) * 2, "n_x x n_x")
+    R = _matrix(fields, "r", (plant.u.size,) * 2, "n_u x n_u")
     return lqr(plant, Q, R, name=name, dt=dt, reads=_group(plant, reads, fields.path, "read"),
                publishes=_group(plant, publishes, fields.path, "published"))
 
@@ -139,7 +149,7 @@ def _luenberger(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.observers.luenberger import luenberger_observer
 
     if fields.has("gain"):
-        L = _matrix(fields, "gain", (plant.x.size, plant.y.size), diagonal=False)
+        L = _matrix(fields, "gain", (plant.x.size, plant.y.size), "n_x x n_y", diagonal=False)
     else:
         import cvxpy
 
@@ -163,8 +173,8 @@ def _gaussian(kind: str):
         from uvsym.observers import ekf, ukf
 
         n, n_y = plant.x.size, plant.y.size
-        options = {"Q": _matrix(fields, "q", (n, n)), "R": _matrix(fields, "r", (n_y, n_y)),
-                   "P0": _matrix(fields, "p0", (n, n))}
+        options = {"Q": _matrix(fields, "q", (n, n), "n_x x n_x"), "R": _matrix(fields, "r", (n_y, n_y), "n_y x n_y"),
+                   "P0": _matrix(fields, "p0", (n, n), "n_x x n_x")}
         factory = ukf if kind == "ukf" else ekf
         return observer_block(factory(plant, dt=dt, name=name, **options))
 
@@ -200,13 +210,21 @@ def build_block(fields: Fields, plant: System, dt: float) -> Block:
     Raises ScenarioError naming the field: an unknown type or field (with the close match), a
     missing or malformed parameter, or a design that fails for the plant (the design's own message).
     """
+    if fields.schema is not None:  # recording the schema: each type's fields under blocks[<type>]
+        kind = fields.text("type", choices=tuple(BLOCKS))
+        typed = Fields(fields.data, f"blocks[{kind}]", fields.schema)
+        typed.used.add("type")
+        return _build(typed, plant, dt, kind)
     return _built(fields.data, fields.path, plant, dt)
 
 
 @memoized(64)
 def _built(data: dict, path: str, plant: System, dt: float) -> Block:
-    fields = Fields(data, path)
-    kind = fields.text("type", choices=tuple(BLOCKS))
+    return _build(Fields(data, path), plant, dt)
+
+
+def _build(fields: Fields, plant: System, dt: float, kind: str | None = None) -> Block:
+    kind = kind or fields.text("type", choices=tuple(BLOCKS))
     name = fields.text("name", kind)
     try:
         built = BLOCKS[kind](fields, plant, dt, name)

@@ -46,9 +46,10 @@ class Fields:
     def has(self, key: str) -> bool:
         return key in self.data
 
-    def raw(self, key: str, default=None, kind: str = "any", rule: str = ""):
-        """The value as parsed; ``kind`` and ``rule`` only describe it for the schema."""
-        self._record(key, kind, default, rule)
+    def raw(self, key: str, default=None, kind: str = "any", rule: str = "", shown: str | None = None):
+        """The value as parsed; ``kind``, ``rule`` and ``shown`` (the default as the schema gives it,
+        e.g. ``none`` for an optional field) only describe it for the schema."""
+        self._record(key, kind, default, rule, shown)
         self.used.add(key)
         return self.data.get(key, default)
 

@@ -81,10 +81,20 @@ class Scenario:
     diagnosis: DiagnosisSettings | None = None
 
 
-def shipped_scenarios() -> dict[str, Path]:
-    """Example scenarios shipped with uvsym: name -> path."""
+def shipped_scenarios(kind: str = "vehicle") -> dict[str, Path]:
+    """Example scenarios shipped with uvsym: name -> path; ``kind`` "vehicle" (``scenarios/``) or
+    "plant" (scenarios over a registered plant, ``scenarios/plants/``)."""
     folder = resources.files("uvsym.sim") / "scenarios"
+    folder = folder / "plants" if kind == "plant" else folder
     return {Path(str(p)).stem: Path(str(p)) for p in sorted(folder.iterdir(), key=str) if str(p).endswith(".toml")}
+
+
+def every_shipped_scenario() -> dict[str, Path]:
+    """Every scenario shipped by uvsym (vehicles, plants) and by the installed derivations: name -> path."""
+    from uvsym.derivation import study_scenarios
+
+    return {**shipped_scenarios(), **shipped_scenarios("plant"),
+            **{name: file for name, (_, file) in study_scenarios().items()}}
 
 
 def read_scenario_file(path) -> dict:

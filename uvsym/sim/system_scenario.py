@@ -20,7 +20,7 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   isolates its target; default false: detection only, :mod:`uvsym.diagnosis.detectors`),
   ``false_alarms_per_hour`` (designed rate, default 1),
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
-  linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
+  linearised at the plant's operating point, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
 - ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions.
 
@@ -177,19 +177,26 @@ def _point(fields: Fields, key: str, group, default: np.ndarray) -> np.ndarray:
 def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str, float]):
     """The [[faults]] (:func:`uvsym.sim.scenario.fault_tables` over the plant's inputs and outputs),
     the [noise] channels first as whole-run noise faults."""
-    actuator, sensor = fault_tables(items, plant.u.names, plant.y.names, duration, plant.name)
+    schema = items and items[0].schema is not None
+    actuator, sensor = fault_tables(items, plant.u.names, plant.y.names, duration,
+                                    "the plant" if schema else plant.name)
     return actuator, tuple(SensorFault(plant.y.index(name), "noise", std) for name, std in noise.items()) + sensor
 
 
 def _setpoint(fields: Fields, plant: System) -> Block:
     """A [[setpoints]] table: the schedule of one signal, as the block ``setpoint_<signal>``; memoized by
     the table's content (as catalogue blocks are), so that the runs of a campaign share their loop."""
+    if fields.schema is not None:
+        return _schedule_block(fields, plant)
     return _setpoint_block(fields.data, fields.path, plant)
 
 
 @memoized(64)
 def _setpoint_block(data: dict, path: str, plant: System) -> Block:
-    fields = Fields(data, path)
+    return _schedule_block(Fields(data, path), plant)
+
+
+def _schedule_block(fields: Fields, plant: System) -> Block:
     signal = fields.text("signal")
     block = schedule(fields, plant, f"setpoint_{signal}", (signal,))
     fields.done()
@@ -228,7 +235,8 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
     from uvsym.diagnosis.calibration import residual_covariance
 
     residuals = _names(fields, "residuals")
-    targets = fields.raw("targets", None, "list of strings", "the plant input or output each residual points to")
+    targets = fields.raw("targets", None, "list of strings", "the plant input or output each residual points to",
+                         "none")
     known = scenario_loop.plant.u.names + scenario_loop.plant.y.names
     if targets is not None:
         targets = [targets] if isinstance(targets, str) else targets
@@ -259,8 +267,13 @@ DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector}
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
     """The detector a ``[[detectors]]`` table describes: ``DETECTORS[type](fields, name, loop, z0, w0,
-    step)``, each builder reading its own fields; ScenarioError naming the field."""
+    step)``, each builder reading its own fields; ScenarioError naming the field. z0, w0: the point
+    detectors calibrate at: the loop at the plant's operating point (its blocks initialised from
+    their reads there), the first sample's inputs with the noise draws at 0."""
     kind = fields.text("type", choices=tuple(DETECTORS))
+    if fields.schema is not None:  # recording the schema: each type's fields under detectors[<type>]
+        fields = Fields(fields.data, f"detectors[{kind}]", fields.schema)
+        fields.used.add("type")
     name = fields.text("name", kind)
     try:
         detector = DETECTORS[kind](fields, name, scenario_loop, z0, w0, step)
@@ -277,6 +290,9 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     """Validate a scenario over a System given as a dict (the parsed TOML; module docstring) and
     wire its loop; ``root``: the scenario file's folder; ``schema`` collects the fields read."""
     top = Fields(data, "", schema)
+    top.describe("name", "string", "the run's name in results and logs", "the file's name")
+    top.describe("plant_path", "string", "folder a module:function plant is imported from",
+                 "the scenario file's folder")
     name, description = top.text("name", default_name), top.text("description", "")
     plant = _plant(top, Path(root))
     duration, step = top.number("duration", positive=True), top.number("step", positive=True)
@@ -287,6 +303,10 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     substeps = top.integer("substeps", 1, minimum=1, unit="RK4 steps per sample")
     seed = top.integer("seed", 0, unit="noise draws")
     initial = top.table("initial") or top.empty("initial")
+    initial.describe("x", "list or table", "the plant's states: a list in order, or a table state = value",
+                     "the plant's operating point")
+    initial.describe("d", "list or table", "constant disturbances: a list in order, or a table name = value",
+                     "zeros")
     x0 = _point(initial, "x", plant.x, plant.x_op)
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
@@ -298,7 +318,8 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
             if channel not in plant.y.names:
                 raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
                                     f"outputs: {', '.join(plant.y.names)}")
-            noise[channel] = noise_fields.number(channel, positive=True)
+            noise[channel] = Fields(noise_fields.data, noise_fields.path).number(channel, positive=True)
+            noise_fields.used.add(channel)
     blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
     blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
     actuator_faults, sensor_faults = _faults(top.tables("faults"), plant, duration, noise)
@@ -326,8 +347,9 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
         raise ScenarioError(f"initial: {exc}") from None
     names = {b.name for b in blocks}
     detectors = []
+    z_op = initial_state(loop, plant.x_op, W0[0]) if detector_tables else None
     for fields in detector_tables:
-        detector = _detector(fields, loop, z0, W0[0], step)
+        detector = _detector(fields, loop, z_op, W0[0], step)
         if detector.name in names:
             raise ScenarioError(f"{fields.path}.name: {detector.name!r} names a block or detector already")
         names.add(detector.name)
