@@ -87,10 +87,10 @@ class ZonotopeBands:
                 events.append(Event(_time(t[end]), "ambiguous", "|".join(inside), detector=self.name))
             else:
                 events.append(Event(_time(t[end]), "unexplained", detector=self.name))
-            released = np.flatnonzero(quiet[end + 1:])
+            released = np.flatnonzero(quiet[end + self.release:])  # runs of quiet samples after the decision
             if not released.size:
                 break
-            k = end + 1 + int(released[0])
+            k = end + self.release + int(released[0])
             events.append(Event(_time(t[k]), "cleared", detector=self.name))
             k += 1
         return events

@@ -186,6 +186,8 @@ def _noise(fields: Fields, channel: str) -> tuple[str, float]:
     if not isinstance(fields.data[channel], dict):
         return "noise", fields.number(channel, positive=True)
     entry = fields.table(channel)
+    if not entry.has("uniform"):
+        entry.done()  # an unknown key is named first, with its close match
     bound = entry.number("uniform", positive=True)
     entry.done()
     return "uniform_noise", bound

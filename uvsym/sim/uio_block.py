@@ -110,8 +110,8 @@ def _bank_block(bank: UIOBank, plant: System, lin, rows: list[int], name: str) -
         return ca.vertcat(*s_next, 1.0), ca.vertcat(*out)
 
     units = tuple(plant.y.units[i] for i in rows)
-    publishes = Signals(tuple(residual_name(a, y) for a in bank.decoupled for y in measured), units * len(bank.decoupled),
-                        group="residual")
+    publishes = Signals(tuple(residual_name(a, y) for a in bank.decoupled for y in measured),
+                        units * len(bank.decoupled), group="residual")
     state = Signals(tuple(f"z_{a}_{x}" for a in bank.decoupled for x in plant.x.names) + ("started",),
                     plant.x.units * len(bank.decoupled) + ("-",), group="state")
     reads = Signals(measured, units, group="measurement") + plant.u.renamed(group="input")
