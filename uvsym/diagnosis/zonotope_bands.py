@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import read_signal
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError, ScenarioError, SetError
@@ -113,6 +114,14 @@ class _Band:
     upper: np.ndarray
 
 
+@memoized(16)
+def _band(design, vbar: np.ndarray, ebar: np.ndarray, horizon: int, generators: int, reduction: str) -> _Band:
+    """The interval hulls of one observer's healthy-residual zonotopes; memoized in-process (the runs of
+    a campaign share their bands)."""
+    band = residual_bands(design, vbar, ebar, horizon, generators, reduction, track=False)
+    return _Band(band.lower, band.upper)
+
+
 def _time(t: float) -> float:
     return round(float(t), 9)
 
@@ -170,7 +179,7 @@ def zonotope_bands_detector(fields, name: str, loop, z0, w0, step: float) -> Zon
                                 f"still carries ||A^horizon|| = {reach:.3g} of its initial error and noise (above "
                                 f"{HELD_TOLERANCE:g}): its band cannot be held; give a longer horizon")
         try:
-            bands.append(residual_bands(design, vbar, ebar, horizon, generators, reduction, track=False))
+            bands.append(_band(design, vbar, ebar, horizon, generators, reduction))
         except SetError as exc:
             raise ScenarioError(f"{fields.path}.generators: the band of the observer decoupling {actuator} "
                                 f"cannot be propagated: {exc}") from None

@@ -6,7 +6,8 @@ Fields (besides type and name): ``poles`` (n eigenvalues of every observer's ``F
 decoupled by every observer, default all); observer i decouples input i as well (one per input:
 the generalised observer scheme). The plant is linearised at its operating point,
 ``x_{k+1} = G x_k + H u_k + D1 d_k``, ``y = C x``: a discrete plant as it is (its period must be
-the loop's), a continuous one by exact zero-order hold at the loop's period.
+the loop's), a continuous one by the exact zero-order hold of its linearisation at the loop's
+period (a nonlinear plant then differs from the bank's model away from that point).
 
 The block reads the measured outputs and every input, runs the observers on their deviations
 from the operating point (each starts at ``xhat_0 = x_op`` from the first measurement, noise
@@ -27,6 +28,7 @@ from uvsym.errors import ObserverError, ScenarioError, UIOConditionError
 from uvsym.observers.uio_bank import UIOBank, uio_bank
 from uvsym.sim.blocks import Block, block
 from uvsym.sim.fields import Fields
+from uvsym.systems.discretize import zoh_matrices
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
@@ -73,13 +75,16 @@ def uio_bank_block(fields: Fields, plant: System, dt: float, name: str) -> UIOBa
             p, bool) and abs(p) < 1 for p in poles):
         raise ScenarioError(f"{fields._name('poles')}: expected {n} real eigenvalues inside the unit circle, got "
                             f"{poles!r}")
-    sampled = plant if plant.discrete else plant.discretize(dt, "zoh")
-    lin = sampled.linearize()
+    lin = plant.linearize()
+    G, H, E = lin.A, lin.B, lin.E
+    if not plant.discrete:  # the linearisation's exact zero-order hold at the loop's period
+        G, HE = zoh_matrices(lin.A, np.hstack([lin.B, lin.E]), dt)
+        H, E = HE[:, :plant.u.size], HE[:, plant.u.size:]
     rows = [plant.y.index(y) for y in measured]
-    D1 = lin.E[:, [plant.d.index(d) for d in decouple]]
+    D1 = E[:, [plant.d.index(d) for d in decouple]]
     outputs = Signals(measured, tuple(plant.y.units[i] for i in rows), group="measurement")
     try:
-        bank = uio_bank(lin.A, lin.B, lin.C[rows], D1, np.asarray(poles, dtype=float), states=plant.x,
+        bank = uio_bank(G, H, lin.C[rows], D1, np.asarray(poles, dtype=float), states=plant.x,
                         outputs=outputs, inputs=plant.u, dt=dt, name=name)
     except UIOConditionError as exc:
         raise ScenarioError(f"{fields._name('measured')}: no unknown-input observer exists for the outputs "
