@@ -202,3 +202,42 @@ def test_bad_input_is_named_before_any_run(change, field, words):
     with pytest.raises(ScenarioError, match=field) as info:
         parse_system_scenario(_bad(change), root=DERIVATION.scenarios["abrupt_actuator1"].parent)
     assert words in str(info.value)
+
+
+def test_uniform_sensor_noise_is_the_specification_not_a_fault():
+    from uvsym.campaign.metrics import truth
+
+    table = shipped("abrupt_actuator1")
+    table["faults"] = []
+    scenario = parse_system_scenario(table, root=DERIVATION.scenarios["abrupt_actuator1"].parent)
+    assert {f.kind for f in scenario.sensor_faults} == {"uniform_noise"}
+    assert truth(scenario)["n_faults"] == 0
+
+
+def test_campaign_covers_every_rotor_profile_and_noise_level():
+    from derivations.uio_zonotope.campaign import CAMPAIGN
+    from uvsym.campaign import load_campaign
+
+    campaign = load_campaign(CAMPAIGN)  # every run's scenario is validated here
+    faulty = [run.scenario["faults"][0] for run in campaign.runs if run.scenario["faults"]]
+    assert {f["actuator"] for f in faulty} == {"Vf", "Vb", "Vr", "Vl"}
+    assert {f.get("profile", "step") for f in faulty} == {"step", "ramp", "intermittent"}
+    assert {f["kind"] for f in faulty} == {"bias", "constant"}
+    levels = {round(run.scenario["noise"]["w"]["uniform"] / NOISE_BOUND["w"], 9) for run in campaign.runs}
+    assert levels == {1.0, 2.0, 3.0}
+    healthy = [run.scenario for run in campaign.runs if not run.scenario["faults"]]
+    assert sum(s["duration"] for s in healthy if s["noise"]["w"]["uniform"] == NOISE_BOUND["w"]) >= 300.0
+    assert min(abs(f["value"]) for f in faulty if f["kind"] == "bias") < 0.5  # below the detectable
+
+
+def test_campaign_metrics_hook_reads_the_first_alarm_and_decision():
+    from derivations.uio_zonotope.campaign import metrics
+
+    table = shipped("abrupt_actuator1")
+    scenario = parse_system_scenario(table, root=DERIVATION.scenarios["abrupt_actuator1"].parent)
+    events = [{"t": 0.2, "event": "detected", "target": None, "detector": "bands"},
+              {"t": 0.4, "event": "ambiguous", "target": "Vf|Vb", "detector": "bands"},
+              {"t": 0.6, "event": "detected", "target": None, "detector": "bands"},
+              {"t": 0.9, "event": "unexplained", "target": None, "detector": "bands"}]
+    assert metrics(scenario, None, events) == {"first_alarm_s": 0.2, "decision": "unexplained"}  # onset 0.5 s
+    assert metrics(scenario, None, [])["decision"] == "none"
