@@ -33,7 +33,7 @@ from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import read_signal
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError, ScenarioError, SetError
-from uvsym.observers.uio_bank import outside_band, residual_bands
+from uvsym.observers.uio_bank import isolate, outside_band, residual_bands
 from uvsym.sets.reduction import METHODS
 
 __all__ = ["HELD_TOLERANCE", "ZonotopeBands", "zonotope_bands_detector"]
@@ -81,7 +81,7 @@ class ZonotopeBands:
             end = k + self.isolation_window - 1
             if end >= t.size:
                 break
-            inside = [a for a, column in zip(self.actuators, outside[k:end + 1].T) if not column.any()]
+            inside = isolate(outside, self.actuators, k, self.isolation_window)
             if len(inside) == 1:
                 events.append(Event(_time(t[end]), "isolated", inside[0], detector=self.name))
             elif inside:
