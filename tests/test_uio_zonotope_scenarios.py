@@ -241,3 +241,16 @@ def test_campaign_metrics_hook_reads_the_first_alarm_and_decision():
               {"t": 0.9, "event": "unexplained", "target": None, "detector": "bands"}]
     assert metrics(scenario, None, events) == {"first_alarm_s": 0.2, "decision": "unexplained"}  # onset 0.5 s
     assert metrics(scenario, None, [])["decision"] == "none"
+
+
+def test_uvsym_simulate_prints_the_bank_decisions_and_writes_the_log(tmp_path, capsys):
+    import json
+
+    from uvsym.cli import main
+
+    assert main(["simulate", "abrupt_actuator1", "--events", str(tmp_path / "events.json")]) == 0
+    lines = [line.split() for line in capsys.readouterr().out.splitlines()]
+    assert ["0.5100", "s", "bands", "detected", "-"] in lines and ["1.0000", "s", "bands", "isolated", "Vf"] in lines
+    log = json.loads((tmp_path / "events.json").read_text())
+    assert [(e["event"], e["target"], e["detector"]) for e in log] == [("detected", None, "bands"),
+                                                                       ("isolated", "Vf", "bands")]
