@@ -396,9 +396,11 @@ def test_a_dask_worker_killed_under_a_chunk_has_the_chunk_rerun_run_by_run(tmp_p
     assert _executed(tmp_path) == [3]  # once, after the chunk was split (run 2 killed its worker first)
 
 
-def test_a_study_scenario_is_named_as_such(tmp_path):
-    """compass_10deg is shipped with the sensor-fdi-lms study, not as a vehicle scenario: the error says so."""
-    text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1]\n'
-    with pytest.raises(CampaignError, match="scenario of the sensor-fdi-lms study, whose experiments do not run in "
-                                             "campaigns yet"):
-        load_campaign(_write(tmp_path, text))
+def test_a_shipped_study_scenario_runs_in_a_campaign_by_its_name(tmp_path):
+    """abrupt_actuator1 is shipped with the uio-zonotope study, in the format over a plant: a campaign
+    finds it by name and sweeps its fields."""
+    text = ('name = "s"\n[[case]]\nname = "a"\nscenario = "abrupt_actuator1"\n[case.grid]\n'
+            '"faults[0].value" = [2.0, 10.0]\n')
+    campaign = load_campaign(_write(tmp_path, text))
+    assert [r.scenario["faults"][0]["value"] for r in campaign.runs] == [2.0, 10.0]
+    assert all(r.scenario["plant"].endswith(":hover_plant") for r in campaign.runs)

@@ -160,7 +160,7 @@ def test_registries_round_trip_and_are_read_only():
         assert sensor_kind(name) is kind and kind.name == name
         assert SensorFault(0, name, 0.5).kind_object is kind
     assert set(ACTUATOR_KINDS) == {"proportional", "bias", "constant", "loss_of_effectiveness"}
-    assert set(SENSOR_KINDS) == {"bias", "drift", "stuck", "noise"}
+    assert set(SENSOR_KINDS) == {"bias", "drift", "stuck", "noise", "uniform_noise"}
     with pytest.raises(TypeError):
         ACTUATOR_KINDS["wobble"] = ACTUATOR_KINDS["bias"]
 
@@ -180,3 +180,12 @@ def test_a_gain_at_the_tolerance_leaves_nothing_to_correct():
     with pytest.raises(IdentifiabilityError, match="proportional fault of 1e-09 leaves the command no effect"):
         actuator_kind("proportional").correction(1e-9)
     assert actuator_kind("proportional").correction(2e-9) == (pytest.approx(5e8), 0.0)
+
+
+def test_uniform_noise_maps_standard_normal_draws_into_its_bound():
+    """erf(n / sqrt 2) of a standard normal n is uniform in [-1, 1]: the quartiles of n (+-0.6745) land at
+    +-1/2, the median at 0, and no draw leaves the bound."""
+    kind = sensor_kind("uniform_noise")
+    assert kind.noise and sensor_kind("noise").noise and not sensor_kind("bias").noise
+    for n, expected in ((0.0, 0.0), (0.6744897501960817, 0.5), (-0.6744897501960817, -0.5), (40.0, 1.0)):
+        assert float(kind.measure(1.0, 0.2, 0.0, 0.0, 0.0, n)) == pytest.approx(1.0 + 0.2 * expected, abs=1e-12)

@@ -19,7 +19,8 @@ What a derivation implements:
 - ``simulate``, optional: ``simulate(table, name=..., progress=..., method=None) -> SimResult`` runs
   a scenario of this study given as the parsed TOML ``table`` (without its ``study`` key); it
   validates every field and raises :class:`~uvsym.errors.ScenarioError` naming the field;
-- ``scenarios``, optional: shipped example scenario name -> TOML path (each with ``study = NAME``).
+- ``scenarios``, optional: shipped example scenario name -> TOML path (a scenario file naming its
+  ``plant``, run by :mod:`uvsym.sim.system_scenario`, or one with ``study = NAME`` run by ``simulate``).
 
 What it gets for free:
 
@@ -76,8 +77,10 @@ class Derivation:
         if not isinstance(self.scenarios, Mapping):
             raise DerivationError(f"derivation {self.name!r}: scenarios must map names to TOML paths, "
                                   f"got {type(self.scenarios).__name__}")
-        if self.scenarios and self.simulate is None:
-            raise DerivationError(f"derivation {self.name!r}: ships scenarios but has no simulate")
+        studied = [name for name, path in self.scenarios.items() if _names_a_study(Path(path))]
+        if studied and self.simulate is None:
+            raise DerivationError(f"derivation {self.name!r}: ships scenarios but has no simulate for their "
+                                  f"study = ... tables ({', '.join(studied)})")
         parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
                  **({} if self.simulate is None else {"simulate": self.simulate}),
                  **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}
@@ -86,6 +89,16 @@ class Derivation:
             raise DerivationError(f"derivation {self.name!r}: not callable: {', '.join(bad)}")
         object.__setattr__(self, "observer_sets", MappingProxyType(dict(self.observer_sets)))
         object.__setattr__(self, "scenarios", MappingProxyType({k: Path(v) for k, v in self.scenarios.items()}))
+
+
+def _names_a_study(path: Path) -> bool:
+    """True for a scenario file with a top-level ``study = ...`` (run by its derivation's simulate)."""
+    import tomllib
+
+    try:
+        return "study" in tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError):
+        return False  # reading it fails later, naming the file
 
 
 def _entry_points() -> dict[str, EntryPoint]:

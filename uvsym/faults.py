@@ -127,12 +127,14 @@ class SensorKind(_Kind):
 
     ``measure(v, f, t, onset, held, noise)`` is the faulty measurement (t, onset in s; held the
     value latched at the last healthy sample; noise a standard normal draw); ``latches`` is True
-    for a kind that keeps ``held`` from the onset on.
+    for a kind that keeps ``held`` from the onset on; ``noise`` for a kind that is sensor noise (the
+    sensors' specification when it acts the whole run, not a fault).
     """
 
     TARGET: ClassVar[str] = "sensor"
     measure: Callable
     latches: bool = False
+    noise: bool = False
 
 
 _ANY = (-math.inf, math.inf)
@@ -146,7 +148,10 @@ SENSOR_KINDS = MappingProxyType({kind.name: kind for kind in (
     SensorKind("bias", _ANY, lambda v, f, t, onset, held, noise: v + f),
     SensorKind("drift", _ANY, lambda v, f, t, onset, held, noise: v + f * (t - onset)),  # f per second
     SensorKind("stuck", _ANY, lambda v, f, t, onset, held, noise: held, latches=True),
-    SensorKind("noise", (0.0, math.inf), lambda v, f, t, onset, held, noise: v + f * noise),  # f: std
+    SensorKind("noise", (0.0, math.inf), lambda v, f, t, onset, held, noise: v + f * noise, noise=True),  # f: std
+    # f: the bound; erf(n / sqrt 2) of a standard normal n is uniform in [-1, 1]
+    SensorKind("uniform_noise", (0.0, math.inf),
+               lambda v, f, t, onset, held, noise: v + f * ca.erf(noise / math.sqrt(2.0)), noise=True),
 )})
 
 
@@ -254,7 +259,8 @@ class SensorFault:
 
     kind: a name in SENSOR_KINDS -- bias ``y + value``; drift ``y + value (t - onset)`` (value
     per second); stuck: the value measured at the last sample before onset; noise
-    ``y + value n_k``, n_k standard normal per sample (value is the standard deviation, >= 0).
+    ``y + value n_k``, n_k standard normal per sample (value is the standard deviation, >= 0);
+    uniform_noise ``y + value erf(n_k / sqrt 2)``, uniform in ``[-value, value]`` (value the bound).
     """
 
     channel: int

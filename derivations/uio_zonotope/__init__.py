@@ -1,15 +1,15 @@
 """A bank of unknown-input observers with zonotope thresholds on a quadrotor (Yang, Hu & Zhang).
 
-``uvsym report uio-zonotope`` (:mod:`.report`), ``uvsym verify uio-zonotope`` (:mod:`.claims`),
-``uvsym simulate FILE.toml`` for a file with ``study = "uio-zonotope"`` (:mod:`.scenario`; shipped:
-``abrupt_actuator1``, ``drift_actuator2``).
+``uvsym report uio-zonotope`` (:mod:`.report`, with the campaign of ``campaign.toml``),
+``uvsym verify uio-zonotope`` (:mod:`.claims`), ``uvsym simulate abrupt_actuator1`` (or
+``drift_actuator2``): scenario files over the study's plant with the ``uio_bank`` block and the
+``zonotope_bands`` detector.
 """
 
 from pathlib import Path
 
 from derivations.uio_zonotope.claims import enclosure_claim, uio_claims
 from derivations.uio_zonotope.report import build
-from derivations.uio_zonotope.scenario import simulate
 from uvsym.derivation import Derivation
 
 __all__ = ["DERIVATION"]
@@ -27,6 +27,5 @@ DERIVATION = Derivation(
     title="Unknown-input observer bank with zonotope thresholds on a quadrotor",
     build=build,
     claims=claims,
-    simulate=simulate,
     scenarios={path.stem: path for path in sorted(SCENARIOS.glob("*.toml"))},
 )

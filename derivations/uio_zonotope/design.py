@@ -28,7 +28,7 @@ from uvsym.sim.feedback import lqr_gain
 from uvsym.systems import System, system
 
 __all__ = ["ATTITUDE", "DT", "ERROR_BOUND", "GENERATORS", "NOISE_BOUND", "POLES", "REDUCTION", "SAMPLES", "Design",
-           "bands", "design", "linear_plant"]
+           "bands", "design", "hover_plant", "linear_plant"]
 
 DT = 0.01  # s, the paper's sample period
 SAMPLES = 300  # samples per run (3 s)
@@ -90,6 +90,12 @@ def design() -> Design:
     bank = uio_bank(G, H, C, D1, POLES, states=plant.x, outputs=plant.x, inputs=plant.u, dt=DT)
     K = lqr_gain(G, H, *LQR_WEIGHTS, DT)
     return Design(plant, G, H, D1, C, K, bank, _bands(bank, SAMPLES))
+
+
+def hover_plant() -> System:
+    """The discrete plant of :func:`design` (all eight states measured, ``y = x``), for scenario files:
+    ``plant = "derivations.uio_zonotope.design:hover_plant"``."""
+    return design().plant
 
 
 @functools.lru_cache(maxsize=4)

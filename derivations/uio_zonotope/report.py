@@ -8,6 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from derivations.papers import paper
+from derivations.uio_zonotope import campaign as study_campaign
 from derivations.uio_zonotope.claims import enclosure_claim, uio_claims
 from derivations.uio_zonotope.design import (
     ATTITUDE,
@@ -108,8 +109,22 @@ def build(out_dir: Path, progress) -> None:
         "full_state_claims": sum(c.expected == "proved" for c in certificates),
         "claims": claims,
     }
+    results["campaign"] = study_campaign.campaign_results(out_dir, progress)
+    results["scenario_events"] = _scenario_events()
     write_json(out_dir / "results.json", results)
-    (out_dir / "report.md").write_text(_report(results))
+    (out_dir / "report.md").write_text(_report(results) + "\n" + study_campaign.section(results["campaign"],
+                                                                                       results["scenario_events"]))
+
+
+def _scenario_events() -> dict:
+    """The decision log of each shipped scenario file (name -> events), as ``uvsym simulate`` prints it."""
+    from derivations.uio_zonotope import DERIVATION
+    from uvsym.sim.scenario import read_scenario_file
+    from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
+
+    return {name: simulate_system_scenario(parse_system_scenario(read_scenario_file(path), name, path.parent),
+                                           compiled=False).meta["events"]
+            for name, path in DERIVATION.scenarios.items()}
 
 
 def _report(r: dict) -> str:

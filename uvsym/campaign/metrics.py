@@ -65,7 +65,7 @@ def truth(scenario) -> dict:
     faults = [(f.profile.onset, 0, i, inputs[f.actuator], None, f) for i, f in enumerate(scenario.actuator_faults)]
     faults += [(f.profile.onset, 1, i, None, outputs[f.channel], f)
                for i, f in enumerate(scenario.sensor_faults)
-               if not (f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end))]
+               if not (f.kind_object.noise and f.profile.onset == 0.0 and math.isinf(f.profile.end))]
     row = {"n_faults": len(faults), "true_actuator": None, "true_sensor": None, "true_kind": None,
            "true_value": None, "onset_s": None, "end_s": None}
     if faults:

@@ -7,8 +7,11 @@ Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
-``d``: constant disturbances), ``[noise]`` (output = standard deviation, the sensors'
-specification, acting the whole run), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
+``d``: constant disturbances), ``[noise]`` (output = standard deviation of Gaussian noise, or
+output = ``{ uniform = bound }`` for noise uniform in ``[-bound, bound]``: the sensors'
+specification, acting the whole run; the threshold calibration linearises the noise at its draw 0,
+so it takes uniform noise for Gaussian noise of standard deviation ``bound sqrt(2 / pi)``, above
+its true ``bound / sqrt 3``), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
 ``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
 estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
 ``sensor`` = an output name, ``kind``, ``value`` and the profile fields of vehicle scenarios),
@@ -22,7 +25,11 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at the plant's operating point, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
-- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions.
+- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions;
+- ``type = "zonotope_bands"``: ``bank`` (a uio_bank block's name), ``noise_bound`` and
+  ``initial_error`` (the stated bounds), ``generators``, ``reduction``, ``horizon``,
+  ``isolation_window``, ``release``: band exits of the bank, isolation by their pattern
+  (:mod:`uvsym.diagnosis.zonotope_bands`).
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
@@ -40,6 +47,7 @@ import numpy as np
 
 from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
+from uvsym.diagnosis.zonotope_bands import zonotope_bands_detector
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
@@ -174,13 +182,25 @@ def _point(fields: Fields, key: str, group, default: np.ndarray) -> np.ndarray:
     return Fields({key: value}, fields.path).vector(key, group.size)
 
 
-def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str, float]):
+def _noise(fields: Fields, channel: str) -> tuple[str, float]:
+    """(sensor fault kind, value) of one [noise] entry: a standard deviation, or ``{ uniform = bound }``."""
+    if not isinstance(fields.data[channel], dict):
+        return "noise", fields.number(channel, positive=True)
+    entry = fields.table(channel)
+    if not entry.has("uniform"):
+        entry.done()  # an unknown key is named first, with its close match
+    bound = entry.number("uniform", positive=True)
+    entry.done()
+    return "uniform_noise", bound
+
+
+def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str, tuple[str, float]]):
     """The [[faults]] (:func:`uvsym.sim.scenario.fault_tables` over the plant's inputs and outputs),
     the [noise] channels first as whole-run noise faults."""
     schema = items and items[0].schema is not None
     actuator, sensor = fault_tables(items, plant.u.names, plant.y.names, duration,
                                     "the plant" if schema else plant.name)
-    return actuator, tuple(SensorFault(plant.y.index(name), "noise", std) for name, std in noise.items()) + sensor
+    return actuator, tuple(SensorFault(plant.y.index(name), *spec) for name, spec in noise.items()) + sensor
 
 
 def _setpoint(fields: Fields, plant: System) -> Block:
@@ -262,7 +282,7 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
     return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
 
 
-DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector}
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": zonotope_bands_detector}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
@@ -311,14 +331,15 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
     noise_fields = top.table("noise")
-    top.describe("noise.<output>", "number", "standard deviation of the output's sensor noise (its unit)", "none")
+    top.describe("noise.<output>", "number or table", "standard deviation of the output's Gaussian sensor noise, "
+                 "or { uniform = bound } (its unit)", "none")
     noise = {}
     if noise_fields is not None:
         for channel in list(noise_fields.data):
             if channel not in plant.y.names:
                 raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
                                     f"outputs: {', '.join(plant.y.names)}")
-            noise[channel] = Fields(noise_fields.data, noise_fields.path).number(channel, positive=True)
+            noise[channel] = _noise(Fields(noise_fields.data, noise_fields.path), channel)  # no per-plant rows
             noise_fields.used.add(channel)
     blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
     blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
