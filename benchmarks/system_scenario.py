@@ -10,6 +10,11 @@ detectors; 6 s at 1 ms), each figure the median of single calls:
 - ``cli_s``: ``uvsym simulate FILE`` end to end in a new process (imports, parse, run, printing);
 - ``hour_simulate_s`` / ``hour_decide_s``: a healthy hour at 10 ms (360,001 samples), simulation
   and the detectors' decisions on its record;
+- ``new_fault_size_s``: parse and simulate a speed bias of a size not run before (the loop's
+  compiled step is shared by every fault of one shape: nothing is compiled again);
+- ``batch16_s`` / ``scalar16_s``: 16 variants (bias sizes, onsets, seeds) by
+  :func:`~uvsym.sim.batch.simulate_batch` (4 lanes) and one :func:`simulate_system_scenario` after
+  another, with ``batch_speedup`` their ratio;
 - ``campaign_s``: ``uvsym campaign examples/dc_motor/campaign.toml`` (48 runs, 2 workers) end to
   end, with ``campaign_sim_s_per_wall_s`` the simulated seconds per wall second.
 
@@ -76,6 +81,23 @@ def main() -> None:
                 "decide_s": statistics.median(r[2] for r in runs)}
     results["cli_s"] = _median(lambda: subprocess.run([str(uvsym), "simulate", str(SCENARIO)], capture_output=True,
                                                       check=True), 5)
+
+    sizes = iter(range(1, 1000))
+
+    def new_size():
+        fault = dict(table["faults"][0], value=0.1 * next(sizes) + 0.01)
+        simulate_system_scenario(parse_system_scenario(dict(table, faults=[fault]), root=EXAMPLE))
+
+    results["new_fault_size_s"] = _median(new_size)
+    from uvsym.sim.batch import simulate_batch
+
+    variants = [parse_system_scenario(dict(table, seed=k, faults=[dict(table["faults"][0], value=0.5 + k,
+                                                                         onset=1.0 + 0.25 * k)]), root=EXAMPLE)
+                for k in range(16)]
+    simulate_batch(variants[:4])  # the lanes built once
+    results["batch16_s"] = _median(lambda: simulate_batch(variants), 5)
+    results["scalar16_s"] = _median(lambda: [simulate_system_scenario(v) for v in variants], 5)
+    results["batch_speedup"] = results["scalar16_s"] / results["batch16_s"]
 
     hour = dict(table, faults=[], duration=3600.0, step=0.01)
     hourly = parse_system_scenario(hour, root=EXAMPLE)
