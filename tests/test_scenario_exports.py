@@ -72,7 +72,7 @@ def test_verify_proves_the_luenberger_design_and_says_what_it_cannot_claim(tmp_p
     assert main(["verify", str(SCENARIO), "--out", str(tmp_path)]) == 0
     text = capsys.readouterr().out
     assert "luenberger on dc_motor: linearised error decays at rate 20 1/s" in text
-    assert "ukf: its state (5 entries) is not an estimate" in text and "speed: a controller" in text
+    assert "ukf: its state (5 entries) is not an estimate" in text and "speed: runs no observer" in text
     rows = json.loads((tmp_path / "dc_motor_speed_sensor_bias" / "proofs.json").read_text())
     assert [r["status"] for r in rows] == ["proved", "proved"]
 
@@ -91,3 +91,10 @@ def test_verify_refutes_a_gain_that_makes_the_sampled_observer_expand(tmp_path):
     certificates, _ = scenario_claims(scenario, table)
     assert [c.status for c in certificates] == ["refuted"]
     assert not certificates[0].as_expected
+
+
+def test_a_shipped_scenario_is_exported_and_verified_by_its_name(tmp_path, capsys):
+    assert main(["verify", "rov_yaw_compass_bias", "--out", str(tmp_path)]) == 0
+    assert "observer on rov_yaw: linearised error decays at rate 1 1/s" in capsys.readouterr().out
+    assert main(["codegen", "rov_yaw_compass_bias", "-o", str(tmp_path / "c")]) == 0
+    assert (tmp_path / "c" / "src" / "rov_yaw_compass_bias.c").exists()

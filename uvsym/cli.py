@@ -290,7 +290,10 @@ def _read_system_scenario(source: str, command: str):
 
 
 def _is_scenario_file(name: str) -> bool:
-    return name.endswith(".toml")
+    """A scenario file, or the name of a shipped scenario (rather than a derivation or an observer set)."""
+    from uvsym.sim.scenario import every_shipped_scenario
+
+    return name.endswith(".toml") or Path(name).is_file() or name in every_shipped_scenario()
 
 
 def _cmd_codegen(args) -> int:

@@ -102,7 +102,8 @@ def scenario_claims(scenario, table: dict) -> tuple[list, list[str]]:
     for block in scenario_blocks(scenario):
         observer = block.source
         if observer is None:
-            notes.append(f"{block.name}: a controller, not an estimator: nothing claimed")
+            notes.append(f"{block.name}: runs no observer of the plant's state (a controller, a schedule or a "
+                         "bank of its own): nothing claimed")
             continue
         if observer.state.size != plant.x.size:
             notes.append(f"{block.name}: its state ({observer.state.size} entries) is not an estimate of "
