@@ -161,6 +161,10 @@ def test_the_correction_comes_back_from_the_update_that_identifies_the_fault():
     assert (estimate.kind, estimate.time_s) == ("bias", T[5]) and estimate.value == pytest.approx(13.0, abs=1e-9)
     assert diagnosis.decided and diagnosis.isolation_time_s == T[5]
     assert diagnosis.update(T[5:] + 0.1, _signals(1)) is None  # nothing new identified: no new correction
+    log = [e.as_dict() for e in diagnosis.events]                # the one event log's vocabulary
+    assert [(e["event"], e["target"], e["kind"], e["t"]) for e in log] == [
+        ("detected", None, None, T[5]), ("isolated", "X", "bias", T[5]), ("identified", "X", "bias", T[5])]
+    assert log[2]["value"] == pytest.approx(13.0, abs=1e-9) and {e["detector"] for e in log} == {"fault_diagnosis"}
 
 
 def test_without_correction_the_supervisor_only_identifies():

@@ -26,7 +26,9 @@ from uvsym.observers.ftc import Correction, linear_correction
 from uvsym.observers.identification import ActuatorFaultEstimate, actuator_values, configuration_at
 from uvsym.observers.isolation import IsolationResult, IsolationSettings, Isolator
 
-__all__ = ["FaultDiagnosis"]
+__all__ = ["FaultDiagnosis", "DETECTOR"]
+
+DETECTOR = "fault_diagnosis"  # the name its events carry
 
 # rows of the 6-DOF force vector that a model's channels occupy
 _ROWS = {6: (0, 1, 2, 3, 4, 5), 3: (0, 1, 5)}
@@ -62,6 +64,20 @@ class FaultDiagnosis:
         """Time (s) by which every actuator was decided (NaN while some is not)."""
         times = [f.time_s for f in self.identified.values()] + list(self.healthy.values())
         return max(times) if self.decided else float("nan")
+
+    @property
+    def events(self) -> list:
+        """The decisions in the one event log (:class:`uvsym.diagnosis.events.Event`, detector
+        ``fault_diagnosis``): ``detected`` when the first channel is decided faulty, then per identified
+        actuator ``isolated`` (its kind) and ``identified`` (its kind and value) at its decision time."""
+        from uvsym.diagnosis.events import Event  # the diagnosis package builds on uvsym.sim, which builds on this
+
+        faulty = [d.time_s for d in self.isolator.decisions.values() if d.kind != "healthy"]
+        events = [Event(min(faulty), "detected", detector=DETECTOR)] if faulty else []
+        for label, estimate in sorted(self.identified.items(), key=lambda item: item[1].time_s):
+            events += [Event(estimate.time_s, "isolated", label, estimate.kind, detector=DETECTOR),
+                       Event(estimate.time_s, "identified", label, estimate.kind, estimate.value, DETECTOR)]
+        return sorted(events, key=lambda e: e.t)
 
     def update(self, t: np.ndarray, signals: dict[str, np.ndarray]) -> Correction | None:
         """Supervisor step (see :class:`uvsym.sim.Supervisor`); a new Correction or None."""
