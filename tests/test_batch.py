@@ -78,7 +78,7 @@ def test_runs_without_a_compiler_fall_back_to_the_scalar_path(scenarios):
 def test_a_batch_refuses_a_supervisor_and_what_is_not_a_scenario(scenarios):
     with pytest.raises(SimulationError, match="without a supervisor"):
         simulate_batch(scenarios, supervisor=object())
-    with pytest.raises(SimulationError, match=r"scenarios\[1\] must be a Scenario, got dict"):
+    with pytest.raises(SimulationError, match=r"scenarios\[1\] must be a Scenario or a SystemScenario, got dict"):
         simulate_batch([scenarios[0], {}])
 
 

@@ -32,7 +32,6 @@ from uvsym.codegen.cache import memoized
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.sim.blocks import Block, observer_block
 from uvsym.sim.fields import Fields
-from uvsym.sim.uio_block import uio_bank_block
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
@@ -200,9 +199,15 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
                                                                                       "input"), **options))
 
 
+def _uio_bank(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.uio_block import uio_bank_block  # here: the zonotope sets load only for a UIO bank
+
+    return uio_bank_block(fields, plant, dt, name)
+
+
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
-          "uio_bank": uio_bank_block}
+          "uio_bank": _uio_bank}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

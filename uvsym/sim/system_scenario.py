@@ -47,7 +47,6 @@ import numpy as np
 
 from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
-from uvsym.diagnosis.zonotope_bands import zonotope_bands_detector
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
@@ -282,7 +281,15 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
     return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
 
 
-DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": zonotope_bands_detector}
+def _zonotope_bands(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                    step: float):
+    """``type = "zonotope_bands"`` (:mod:`uvsym.diagnosis.zonotope_bands`, imported only for one)."""
+    from uvsym.diagnosis.zonotope_bands import zonotope_bands_detector
+
+    return zonotope_bands_detector(fields, name, scenario_loop, z0, w0, step)
+
+
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
