@@ -19,6 +19,8 @@ luenberger       decay (1/s, LMI design certified in exact arithmetic) or gain (
 ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
 lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
                  hold, confirm (samples)
+hybrid           z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
+                 estimator), model, x0 (:mod:`uvsym.sim.hybrid_block`)
 ===============  ==============================================================================
 """
 
@@ -30,6 +32,7 @@ from uvsym.codegen.cache import memoized
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.sim.blocks import Block, observer_block
 from uvsym.sim.fields import Fields
+from uvsym.sim.hybrid_block import hybrid_block
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
@@ -188,7 +191,8 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
 
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
-          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms}
+          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
+          "hybrid": hybrid_block}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:
