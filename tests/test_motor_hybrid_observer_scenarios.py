@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from derivations.motor_hybrid_observer import DERIVATION, SCENARIOS
+from derivations.motor_hybrid_observer.campaign import CAMPAIGN, DETECTORS, STEP_CASE, figures
 from derivations.motor_hybrid_observer.experiment import CASES, run, run_cases
 from uvsym.diagnosis.detectors import EstimatedFault, ResidualThreshold
 from uvsym.errors import DiagnosisError, ScenarioError
@@ -54,6 +55,32 @@ def test_the_files_state_the_studys_calibrated_thresholds(study):
         given = {d["name"]: d["thresholds"][0] for d in _table(name)["detectors"]}
         for observer, detector in DETECTOR.items():
             assert given[detector] == pytest.approx(study["thresholds"][observer], rel=1e-12)
+    campaign = read_scenario_file(CAMPAIGN.with_name("campaign_motor.toml"))
+    given = {d["name"]: d.get("thresholds") for d in campaign["detectors"]}
+    assert given["hybrid_study"][0] == pytest.approx(study["thresholds"]["detection"], rel=1e-12)
+    assert given["hybrid"] is None and given["luenberger_fd"] is None  # designed from the stated noise
+
+
+def _row(case, fault, noise, delay, alarms, duration=6.0):
+    row = {"status": "ok", "case": case, "n_faults": int(fault is not None), "onset_s": 2.0 if fault else None,
+           "duration_s": duration, "true_sensor": "omega_m" if fault else None, "true_kind": "bias",
+           "true_value": fault, "noise.omega_m": noise, "wall_s": 1.0}
+    for d in DETECTORS:
+        row |= {f"{d}:detected": delay is not None, f"{d}:detection_delay_s": delay, f"{d}:false_alarms": alarms,
+                f"{d}:size_error_rel": None, f"{d}:isolation_delay_s": None, f"{d}:identified_value": None}
+    return row
+
+
+def test_campaign_figures_come_from_the_rows():
+    rows = [_row(STEP_CASE, 0.5, 0.02, 0.001, 0), _row(STEP_CASE, 0.1, 0.02, None, 0),
+            _row("no fault", None, 0.02, None, 3, duration=3600.0)]
+    f = figures(rows)
+    assert f["step_detection_delay_s"]["0.02"] == {"0.1": dict.fromkeys(DETECTORS), "0.5": dict.fromkeys(DETECTORS,
+                                                                                                        0.001)}
+    # healthy time: the whole healthy run and the 2 s before each onset
+    assert f["overall"]["hybrid"]["false_alarms_per_hour"] == pytest.approx(3 / ((3600.0 + 4.0) / 3600.0))
+    assert f["healthy_by_noise"]["0.02"]["hybrid"]["false_alarms_per_hour"] == pytest.approx(3.0)
+    assert f["overall"]["hybrid"]["detection_probability"] == 0.5
 
 
 @pytest.mark.parametrize("name", SHIPPED)
