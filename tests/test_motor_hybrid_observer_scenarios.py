@@ -200,3 +200,24 @@ def test_given_thresholds_replace_the_designed_ones_and_are_checked():
         ResidualThreshold("d", ("obs.r",), np.array([1.0]), 0.1, given=(-1.0,))
     with pytest.raises(DiagnosisError, match="gain must be finite and non-zero"):
         _detector(gain=0.0)
+
+
+@pytest.mark.parametrize("name, case", [("motor_luenberger_step", "step (case b)"),
+                                        ("motor_luenberger_incipient", "incipient (case a)")])
+def test_the_luenberger_studys_scenarios_are_its_runs(name, case):
+    """The motor-luenberger study's runs as scenario files (its luenberger block and threshold
+    detector): the same residual (the study runs on CasADi's virtual machine, the file as C: equal
+    to 1e-9) and detection time, at the study's calibrated threshold."""
+    from derivations.motor_luenberger import SCENARIOS as LUENBERGER
+    from derivations.motor_luenberger.experiment import CASES as L_CASES
+    from derivations.motor_luenberger.experiment import run as l_run
+    from derivations.motor_luenberger.experiment import run_cases as l_run_cases
+
+    study = l_run_cases()
+    table = read_scenario_file(LUENBERGER / f"{name}.toml")
+    assert table["detectors"][0]["thresholds"][0] == pytest.approx(study["threshold"], rel=1e-12)
+    result = simulate_system_scenario(parse_system_scenario(table, root=LUENBERGER))
+    mine = l_run(L_CASES[case])
+    assert np.max(np.abs(result["luenberger"]["r_omega_m"] - mine["luenberger"]["r_omega_m"])) < 1e-9
+    expected, got = study["detection_time_s"][case], _first(result, "luenberger_fd")
+    assert (got is None) == (expected is None) and (got is None or abs(got - expected) < 1e-9)
