@@ -32,13 +32,6 @@ from __future__ import annotations
 import numpy as np
 
 from uvsym.errors import ObserverError, ScenarioError
-from uvsym.observers.hybrid import (
-    FaultEstimator,
-    decouple,
-    hybrid_observer,
-    linear_error_model,
-    observer_state,
-)
 from uvsym.sim.blocks import Block, observer_block
 from uvsym.sim.fields import Fields
 from uvsym.systems.signals import signals
@@ -97,7 +90,9 @@ def _k1(fields: Fields, dec, name: str) -> np.ndarray:
     return gains.K[0]
 
 
-def _estimator(fields: Fields, q: int, p2: int) -> FaultEstimator | None:
+def _estimator(fields: Fields, q: int, p2: int):
+    """The FaultEstimator of ``gamma``, ``m1``, ``m2``, or None without them."""
+    from uvsym.observers.hybrid import FaultEstimator
     from uvsym.sim.catalogue import _matrix
 
     given = [key for key in ("gamma", "m1", "m2") if fields.has(key)]
@@ -115,6 +110,7 @@ def _estimator(fields: Fields, q: int, p2: int) -> FaultEstimator | None:
 
 def _start(fields: Fields, model: System, dec, q: int) -> np.ndarray | None:
     """The observer's state for the estimate ``x0`` (module docstring), None without it."""
+    from uvsym.observers.hybrid import observer_state
     from uvsym.sim.system_scenario import _point
 
     if not fields.has("x0"):
@@ -126,6 +122,7 @@ def _start(fields: Fields, model: System, dec, q: int) -> np.ndarray | None:
 
 def hybrid_block(fields: Fields, plant: System, dt: float, name: str) -> Block:
     """The ``hybrid`` block (module docstring) sampled every ``dt`` s; ScenarioError naming the field."""
+    from uvsym.observers.hybrid import decouple, hybrid_observer, linear_error_model  # sympy: only when used
     from uvsym.sim.catalogue import _names
 
     model = _model(fields, plant)
