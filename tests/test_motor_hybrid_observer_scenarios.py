@@ -153,6 +153,7 @@ def test_incomplete_or_foreign_designs_are_refused():
     _refused(lambda t: t["blocks"][1].update(model="quadrotor"), r"blocks\[1\]\.model: quadrotor reads outputs")
     _refused(lambda t: t["blocks"][1].update(sensor="omega"), r"blocks\[1\]\.sensor: 'omega' is not an output")
     _refused(lambda t: t["detectors"][0].pop("targets"), r"detectors\[0\]\.targets: required")
+    _refused(lambda t: t["blocks"][3].update(l=5.0), r"blocks\[3\]\.l: z1 holds every state")
     _refused(lambda t: t["disturbances"][0].update(times=[0.0, 0.0]), r"disturbances\[0\]\.times: expected strictly")
 
 

@@ -141,6 +141,8 @@ def hybrid_block(fields: Fields, plant: System, dt: float, name: str) -> Block:
     except ObserverError as exc:
         raise ScenarioError(f"{fields._name('w1')}: {exc}") from None
     K1 = _k1(fields, dec, name)
+    if not dec.iz2 and fields.has("l"):
+        raise ScenarioError(f"{fields._name('l')}: z1 holds every state, so there is no subsystem 2 to gain")
     L = _gain(fields, "l", dec.C4, 0.0) if dec.iz2 else np.zeros((0, len(dec.iw2)))
     estimator = _estimator(fields, F.shape[1], len(dec.iw2))
     faults = signals((f"f_{sensor}", model.y.units[model.y.index(sensor)], f"fault of sensor {sensor}"),
