@@ -8,6 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from derivations.motor_hybrid_observer.analysis import corrected_model, estimate, estimator_model, step_limit
+from derivations.motor_hybrid_observer.campaign import campaign_results
 from derivations.motor_hybrid_observer.claims import hybrid_claims
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_hybrid_observer.experiment import CASES, DURATION, run_cases
@@ -190,7 +191,8 @@ def build(out_dir: Path, progress) -> None:
     figures = _figures(cases, out_dir)
     progress("C package of the four observers: write, compile, compare")
     c = c_package(motor_hybrid(), out_dir / "c")
+    campaign = campaign_results(progress)
     results = _results(cases) | {"c": c, "claims": claim_rows(claims),
-                                 "claim_evidence": [c.counterexample for c in claims]}
+                                 "claim_evidence": [c.counterexample for c in claims], "campaign": campaign}
     write_json(out_dir / "results.json", results)
     (out_dir / "report.md").write_text(report_text(results, figures))

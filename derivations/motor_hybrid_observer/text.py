@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from derivations.motor_hybrid_observer.campaign_text import campaign_section
 from derivations.motor_hybrid_observer.claims import OVERSHOOT
 from derivations.motor_hybrid_observer.design import (
     BASELINE_DECAY,
@@ -209,6 +210,7 @@ the noise level.
 
 {figs}
 
+{campaign_section(r["campaign"])}
 ## Generated C
 
 {c_section(r["c"], "The four observers' steps (detection, estimator, baseline, corrected)")}

@@ -16,7 +16,15 @@ only with ``isolate`` set, which claims that the residuals are structured (each 
 its target's fault alone): an observer's output residuals are not (an actuator fault moves them
 as a sensor fault does), so by default the detector detects and does not isolate. ``cleared``
 once ``release`` samples in a row do not (hysteresis: no alarm stays latched after its evidence is gone). Samples before
-``ignore_before`` s (the estimator's start-up) are not judged.
+``ignore_before`` s (the estimator's start-up) are not judged. ``given`` thresholds (the residuals'
+units, e.g. a study's own calibration on fault-free runs) replace ``z sigma``; sigma is then
+reported beside them.
+
+:class:`EstimatedFault` -- a :class:`ResidualThreshold` that detects, and a fault estimate that
+identifies (the hybrid observer's, Yu et al. 2018, eq. 18): ``identified`` on the detected target,
+``identify_after`` s after each detection that has not cleared by then, with value
+``gain x`` the estimate's mean over the last ``average`` s (gain: the sensor's fault direction, so
+that the value is the sensor's offset in its unit, kind ``bias``).
 
 :class:`DoubleCriterion` -- the LMS-FIR monitor's own decision (Zhu et al., Sec. 3.2; published
 as ``fault_<y>``): ``detected`` and ``isolated`` on sensor y when its fault flag rises,
@@ -32,7 +40,7 @@ import numpy as np
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError
 
-__all__ = ["ResidualThreshold", "DoubleCriterion", "threshold_factor", "read_signal"]
+__all__ = ["ResidualThreshold", "DoubleCriterion", "EstimatedFault", "threshold_factor", "read_signal"]
 
 
 def read_signal(result, name: str) -> np.ndarray:
@@ -73,6 +81,7 @@ class ResidualThreshold:
     ignore_before: float = 0.0
     targets: tuple[str | None, ...] = ()
     isolate: bool = False
+    given: tuple[float, ...] = ()
     thresholds: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -90,7 +99,11 @@ class ResidualThreshold:
         object.__setattr__(self, "targets", tuple(targets))
         object.__setattr__(self, "sigma", sigma)
         z = threshold_factor(self.false_alarms_per_hour, self.dt, len(self.residuals))
-        object.__setattr__(self, "thresholds", z * sigma)
+        given = np.asarray(self.given, dtype=float).reshape(-1)
+        if given.size and (given.shape != sigma.shape or not np.all(np.isfinite(given)) or np.any(given <= 0)):
+            raise DiagnosisError(f"detector {self.name}: given thresholds must be {sigma.size} positive finite "
+                                 f"numbers, got {given.tolist()}")
+        object.__setattr__(self, "thresholds", given if given.size else z * sigma)
 
     def decide(self, result) -> list[Event]:
         """The detections and clearances of the record (module docstring)."""
@@ -117,7 +130,8 @@ class ResidualThreshold:
 
     def design(self) -> dict:
         """What the decision rule is designed for: per-sample and per-hour false-alarm rates and thresholds."""
-        return {"detector": self.name, "rule": "|r_i| > z sigma_i", "residuals": list(self.residuals),
+        return {"detector": self.name, "rule": "|r_i| > given c_i" if self.given else "|r_i| > z sigma_i",
+                "residuals": list(self.residuals),
                 "sigma": self.sigma.tolist(), "thresholds": self.thresholds.tolist(),
                 "false_alarms_per_hour": self.false_alarms_per_hour,
                 "per_sample_probability": self.false_alarms_per_hour * self.dt / 3600.0,
@@ -150,3 +164,48 @@ class DoubleCriterion:
         return {"detector": self.name, "rule": "LMS double criterion (eps^2 > eps0 confirmed by R > r0)",
                 "monitor": self.monitor, "sensor": self.sensor}
 
+
+
+@dataclass(frozen=True)
+class EstimatedFault:
+    """Detection by ``threshold`` (its events, named by it), identification by the logged estimate
+    ``estimate`` (``<block>.<signal>``) times ``gain`` (module docstring); identify_after and
+    average in s."""
+
+    name: str
+    threshold: ResidualThreshold
+    estimate: str
+    gain: float = 1.0
+    identify_after: float = 0.5
+    average: float = 0.1
+
+    def __post_init__(self):
+        if self.threshold.name != self.name:
+            raise DiagnosisError(f"detector {self.name}: its threshold test is named {self.threshold.name!r}")
+        for what in ("gain", "identify_after", "average"):
+            value = getattr(self, what)
+            if not (np.isfinite(value) and (value != 0 if what == "gain" else value >= 0)):
+                raise DiagnosisError(f"detector {self.name}: {what} must be finite"
+                                     + (" and non-zero" if what == "gain" else " and >= 0") + f", got {value!r}")
+
+    def decide(self, result) -> list[Event]:
+        """The threshold test's events and, after each detection, its identification (module docstring)."""
+        t = np.asarray(result.t, dtype=float)
+        estimate = self.gain * read_signal(result, self.estimate)
+        events = self.threshold.decide(result)
+        window = max(1, int(round(self.average / self.threshold.dt)))
+        out = []
+        for i, event in enumerate(events):
+            out.append(event)
+            if event.event != "detected":
+                continue
+            cleared = next((e.t for e in events[i + 1:] if e.event == "cleared"), np.inf)
+            k = int(np.searchsorted(t, event.t + self.identify_after - 1e-9))
+            if k < t.size and t[k] < cleared:
+                value = float(np.mean(estimate[max(0, k - window + 1):k + 1]))
+                out.append(Event(round(float(t[k]), 9), "identified", event.target, "bias", value, self.name))
+        return sorted(out, key=lambda e: e.t)
+
+    def design(self) -> dict:
+        return {**self.threshold.design(), "estimate": self.estimate, "estimate_gain": self.gain,
+                "identify_after_s": self.identify_after, "average_s": self.average}

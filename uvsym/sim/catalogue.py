@@ -21,6 +21,8 @@ lms              measured, regressor, reference (signal names), order, mu, eps0,
                  hold, confirm (samples)
 uio_bank         poles (F's n eigenvalues), measured (outputs), decouple (disturbances): one UIO
                  per input, publishing r_<input>_<output> (:mod:`uvsym.sim.uio_block`)
+hybrid           z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
+                 estimator), model, x0 (:mod:`uvsym.sim.hybrid_block`)
 ===============  ==============================================================================
 """
 
@@ -32,6 +34,7 @@ from uvsym.codegen.cache import memoized
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.sim.blocks import Block, observer_block
 from uvsym.sim.fields import Fields
+from uvsym.sim.hybrid_block import hybrid_block
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
@@ -207,7 +210,7 @@ def _uio_bank(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
-          "uio_bank": _uio_bank}
+          "uio_bank": _uio_bank, "hybrid": hybrid_block}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

@@ -7,7 +7,9 @@ Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
-``d``: constant disturbances), ``[noise]`` (output = standard deviation of Gaussian noise, or
+``d``: constant disturbances), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
+``values``, ``interpolation`` "previous" or "linear": its schedule, sampled at every step and held
+over it, instead of its constant), ``[noise]`` (output = standard deviation of Gaussian noise, or
 output = ``{ uniform = bound }`` for noise uniform in ``[-bound, bound]``: the sensors'
 specification, acting the whole run; the threshold calibration linearises the noise at its draw 0,
 so it takes uniform noise for Gaussian noise of standard deviation ``bound sqrt(2 / pi)``, above
@@ -22,6 +24,7 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   input or output each points to), ``isolate`` (the residuals are structured, so the largest one
   isolates its target; default false: detection only, :mod:`uvsym.diagnosis.detectors`),
   ``false_alarms_per_hour`` (designed rate, default 1),
+  ``thresholds`` (given, in the residuals' units, instead of designed: a calibration of one's own),
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at the plant's operating point, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
@@ -30,6 +33,11 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   ``initial_error`` (the stated bounds), ``generators``, ``reduction``, ``horizon``,
   ``isolation_window``, ``release``: band exits of the bank, isolation by their pattern
   (:mod:`uvsym.diagnosis.zonotope_bands`).
+- ``type = "hybrid"``: the fields of ``threshold`` (``targets`` required; ``thresholds``, in the
+  residuals' units, replace the designed ones when given) and ``estimate`` (a fault estimate,
+  ``<block>.f_<sensor>_hat`` of a hybrid block), ``estimate_gain`` (the sensor's fault direction:
+  the identified offset is gain x estimate), ``identify_after`` and ``average`` (s): ``identified``
+  with the mean estimate ``identify_after`` s after each detection.
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
@@ -46,7 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.codegen.cache import memoized
-from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
+from uvsym.diagnosis.detectors import DoubleCriterion, EstimatedFault, ResidualThreshold
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
@@ -82,8 +90,9 @@ class FlagSubstitution:
 @dataclass(frozen=True)
 class SystemScenario:
     """A validated scenario over a System (module docstring): the wired ``loop``, its initial state
-    z0 (n_z,), disturbances d (n_d,), faults (their indices into the plant's inputs and outputs),
-    the substitution supervisor (None without substitutions) and the detectors."""
+    z0 (n_z,), disturbances d (constant (n_d,) or one row per sample (N + 1, n_d)), faults (their
+    indices into the plant's inputs and outputs), the substitution supervisor (None without
+    substitutions) and the detectors."""
 
     name: str
     description: str
@@ -202,6 +211,30 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
     return actuator, tuple(SensorFault(plant.y.index(name), *spec) for name, spec in noise.items()) + sensor
 
 
+def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, step: float) -> np.ndarray:
+    """The [[disturbances]] schedules (module docstring) over the samples ``k step``, k = 0..N: (N + 1,
+    n_d) with the other disturbances at their constants d (n_d,); d itself without schedules."""
+    from uvsym.sim.feedback import INTERPOLATIONS
+
+    if not items:
+        return d
+    table, t = np.tile(d, (N + 1, 1)), step * np.arange(N + 1)
+    for fields in items:
+        signal = fields.text("signal", choices=plant.d.names)
+        times = fields.vector("times", len(fields.data.get("times") or []))
+        values = fields.vector("values", times.size if times is not None else 0)
+        how = fields.text("interpolation", "previous", choices=INTERPOLATIONS)
+        fields.done()
+        if times is None or not times.size or np.any(np.diff(times) <= 0):
+            raise ScenarioError(f"{fields.path}.times: expected strictly increasing times (s), one per value")
+        column = table[:, plant.d.index(signal)]
+        if how == "linear":
+            column[:] = np.interp(t, times, values)
+        else:  # the value of the last time at or before the sample (within 1e-9 s), the first before t_0
+            column[:] = values[np.maximum(np.searchsorted(times, t + 1e-9, side="right") - 1, 0)]
+    return table
+
+
 def _setpoint(fields: Fields, plant: System) -> Block:
     """A [[setpoints]] table: the schedule of one signal, as the block ``setpoint_<signal>``; memoized by
     the table's content (as catalogue blocks are), so that the runs of a campaign share their loop."""
@@ -263,6 +296,7 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
             raise ScenarioError(f"{fields.path}.targets: expected {len(residuals)} names of the plant's inputs or "
                                 f"outputs ({', '.join(known)}), got {targets!r}")
     std = fields.vector("std", len(residuals))
+    given = fields.vector("thresholds", len(residuals))
     options = {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 1.0, positive=True),
                "ignore_before": fields.number("ignore_before", 0.0, minimum=0.0)}
     options["isolate"] = fields.raw("isolate", False, "boolean", "the residuals are structured")
@@ -278,7 +312,8 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
         if silent:
             raise ScenarioError(f"{fields.path}.std: no sensor noise reaches {', '.join(silent)} ([noise] is "
                                 "empty for what it depends on): state the residuals' standard deviations")
-    return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
+    return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()),
+                             given=() if given is None else tuple(given), **options)
 
 
 def _zonotope_bands(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
@@ -289,7 +324,26 @@ def _zonotope_bands(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.
     return zonotope_bands_detector(fields, name, scenario_loop, z0, w0, step)
 
 
-DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands}
+def _hybrid_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                     step: float) -> EstimatedFault:
+    """``type = "hybrid"``: a threshold test (the fields of ``threshold``) that detects, and the hybrid
+    observer's fault estimate that identifies (:class:`~uvsym.diagnosis.detectors.EstimatedFault`)."""
+    estimate = _names(fields, "estimate", size=1)[0]
+    logged = [f"{g}.{label}" for g, entry in scenario_loop.signals.items() if g not in ("x", "u", "y")
+              for label in entry[1]]
+    if estimate not in logged:
+        raise ScenarioError(f"{fields.path}.estimate: {estimate!r} is not a block's published signal "
+                            f"(<block>.<signal>){_close(estimate, logged)}")
+    options = {"gain": fields.number("estimate_gain", 1.0),
+               "identify_after": fields.number("identify_after", 0.5, minimum=0.0),
+               "average": fields.number("average", 0.1, minimum=0.0)}
+    if not fields.has("targets"):
+        raise ScenarioError(f"{fields.path}.targets: required: the sensor each residual points to")
+    return EstimatedFault(name, _threshold_detector(fields, name, scenario_loop, z0, w0, step), estimate, **options)
+
+
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands,
+             "hybrid": _hybrid_detector}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
@@ -337,6 +391,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     x0 = _point(initial, "x", plant.x, plant.x_op)
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
+    d = _disturbances(top.tables("disturbances"), plant, d, round(duration / step), step)
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number or table", "standard deviation of the output's Gaussian sensor noise, "
                  "or { uniform = bound } (its unit)", "none")
@@ -367,7 +422,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
             raise ScenarioError(f"substitutions.{channel}.when: {flag!r} is not a block's published signal "
                                 "(<block>.<signal>)")
         flags.append((channel, group, list(entry[1]).index(label)))
-    W0 = loop_inputs(loop, 0, d, seed)
+    W0 = loop_inputs(loop, 0, d[0] if d.ndim == 2 else d, seed)
     W0[0, 1:1 + plant.y.size] = 0.0
     try:
         z0 = initial_state(loop, x0, W0[0])

@@ -1,0 +1,75 @@
+"""The study's fault campaign (``campaign.toml`` beside this file, over ``campaign_motor.toml``): run
+by the report build through :func:`uvsym.campaign.run_campaign`, the same file ``uvsym campaign``
+runs; every figure here is computed from its rows (per detector, from the event log).
+
+Per detector (``hybrid``: the hybrid detection residual at z sigma for 1 false alarm per hour under
+the stated noise; ``hybrid_study``: the same residual at the study's calibrated threshold;
+``luenberger_fd``: the motor's Luenberger observer at z sigma): detection probability, missed
+detections, median detection delay, median identification error and false alarms per hour, over
+the whole campaign, per case and, for the long healthy runs, per noise level; for the
+speed-sensor steps, the detection of every size at each noise level. CPU times are left out
+(they change from run to run; the report must not).
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from uvsym.campaign import load_campaign, run_campaign
+from uvsym.campaign.summary import detector_rates
+
+__all__ = ["CAMPAIGN", "DETECTORS", "campaign_results", "figures"]
+
+CAMPAIGN = Path(__file__).with_name("campaign.toml")
+DETECTORS = ("hybrid", "hybrid_study", "luenberger_fd")
+STEP_CASE = "speed sensor step"
+HEALTHY_CASE = "no fault"
+RATES = ("runs", "fault_runs", "detection_probability", "missed_detections", "median_detection_delay_s",
+         "median_size_error_rel", "false_alarms", "healthy_hours", "false_alarms_per_hour")
+
+
+def _rates(rows: list[dict]) -> dict:
+    return {d: {k: detector_rates(rows, d)[k] for k in RATES} for d in DETECTORS}
+
+
+def _label(row: dict) -> str:
+    """The fault of a row in words: sensor, kind, profile and size."""
+    if not row["n_faults"]:
+        return "none"
+    profile = row.get("faults[0].profile") or "step"
+    shape = "" if row["true_kind"] != "bias" else f" {profile}" + (
+        f" rate {row['faults[0].rate']:g}" if profile == "incipient" else
+        f" period {row['faults[0].period']:g} duty {row['faults[0].duty']:g}" if profile == "intermittent" else "")
+    return f"{row['true_sensor']} {row['true_kind']}{shape} {row['true_value']:g}"
+
+
+def figures(rows: list[dict]) -> dict:
+    """The campaign's figures (module docstring) from its result rows."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    steps = [r for r in ok if r["case"] == STEP_CASE]
+    sizes = sorted({r["true_value"] for r in steps})
+    noises = sorted({r["noise.omega_m"] for r in steps})
+    grid = {f"{noise:g}": {f"{size:g}": {d: next(r[f"{d}:detection_delay_s"] for r in steps
+                                                 if r["true_value"] == size and r["noise.omega_m"] == noise)
+                                         for d in DETECTORS} for size in sizes} for noise in noises}
+    others = [{"case": r["case"], "fault": _label(r), "onset_s": r["onset_s"],
+               "noise_omega_m": r.get("noise.omega_m"), "duration_s": r["duration_s"],
+               **{f"{d}:{k}": r[f"{d}:{k}"] for d in DETECTORS
+                  for k in ("detection_delay_s", "identified_value", "false_alarms")}}
+              for r in ok if r["case"] != STEP_CASE]
+    return {"runs": len(rows), "errors": len(rows) - len(ok), "overall": _rates(ok),
+            "cases": {case: _rates([r for r in ok if r["case"] == case]) for case in cases},
+            "step_detection_delay_s": grid, "other_runs": others,
+            "healthy_by_noise": {f"{noise:g}": _rates([r for r in ok if r["case"] == HEALTHY_CASE
+                                                        and r["noise.omega_m"] == noise]) for noise in noises}}
+
+
+def campaign_results(progress, workers: int | None = None) -> dict:
+    """Run the campaign in a scratch folder (local processes) and return its :func:`figures`."""
+    campaign = load_campaign(CAMPAIGN)
+    progress(f"fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
+    with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+    return figures(rows)
