@@ -396,9 +396,11 @@ def test_a_dask_worker_killed_under_a_chunk_has_the_chunk_rerun_run_by_run(tmp_p
     assert _executed(tmp_path) == [3]  # once, after the chunk was split (run 2 killed its worker first)
 
 
-def test_a_study_scenario_is_named_as_such(tmp_path):
-    """compass_10deg is shipped with the sensor-fdi-lms study, not as a vehicle scenario: the error says so."""
-    text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1]\n'
-    with pytest.raises(CampaignError, match="scenario of the sensor-fdi-lms study, whose experiments do not run in "
-                                             "campaigns yet"):
-        load_campaign(_write(tmp_path, text))
+def test_a_study_scenario_is_found_by_name(tmp_path):
+    """compass_10deg is shipped with the sensor-fdi-lms study: a campaign names it as it names a vehicle
+    scenario; a misspelt name is refused with the shipped ones listed."""
+    text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1, 2]\n'
+    campaign = load_campaign(_write(tmp_path, text))
+    assert [r.scenario["plant"] for r in campaign.runs] == ["rov_yaw", "rov_yaw"]
+    with pytest.raises(CampaignError, match=r"no shipped scenario 'compass_11deg'; shipped: .*compass_10deg"):
+        load_campaign(_write(tmp_path, text.replace("compass_10deg", "compass_11deg")))

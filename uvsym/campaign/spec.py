@@ -192,14 +192,11 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
     source = fields.text("scenario")
     path = root / source
     if not path.is_file():
-        shipped = shipped_scenarios()
-        if source not in shipped:
-            from uvsym.derivation import study_scenarios
+        from uvsym.derivation import study_scenarios
 
-            study = study_scenarios().get(source)
-            kind = (f" ({source!r} is a scenario of the {study[0]} study, whose experiments do not run in campaigns "
-                    "yet)" if study else "")
-            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}{kind}; "
+        shipped = {**shipped_scenarios(), **{name: file for name, (_, file) in study_scenarios().items()}}
+        if source not in shipped:
+            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}; "
                                 f"shipped: {', '.join(shipped)}")
         path = shipped[source]
     try:

@@ -126,11 +126,13 @@ class ResidualThreshold:
 
 @dataclass(frozen=True)
 class DoubleCriterion:
-    """The LMS monitor ``monitor``'s fault flag on ``sensor`` as events (module docstring)."""
+    """The LMS monitor ``monitor``'s fault flag on ``sensor`` as events (module docstring);
+    ``settings``: the monitor's order, window, hold, confirm and thresholds (its block's description)."""
 
     name: str
     monitor: str
     sensor: str
+    settings: str = ""
 
     def decide(self, result) -> list[Event]:
         t = np.asarray(result.t, dtype=float)
@@ -148,5 +150,5 @@ class DoubleCriterion:
 
     def design(self) -> dict:
         return {"detector": self.name, "rule": "LMS double criterion (eps^2 > eps0 confirmed by R > r0)",
-                "monitor": self.monitor, "sensor": self.sensor}
+                "monitor": self.monitor, "sensor": self.sensor, "settings": self.settings}
 

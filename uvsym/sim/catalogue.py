@@ -19,10 +19,15 @@ luenberger       decay (1/s, LMI design certified in exact arithmetic) or gain (
 ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
 lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
                  hold, confirm (samples)
+select           flag, on, off, output (signal names; on, off, output one name or n each): a
+                 switch of the same sample, ``output = flag ? on : off`` (substitution from the
+                 sample the flag rises; ``[substitutions]`` switch from the next sample)
 ===============  ==============================================================================
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -176,19 +181,32 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
     measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
     regressor = _group(plant, _names(fields, "regressor", size=1), fields.path, "input")
-    reference = fields.raw("reference", None, "string", "signal subtracted before regression", "none")
+    reference = fields.raw("reference", None, "string", "signal subtracted before regression")
     if reference is not None and not isinstance(reference, str):
         raise ScenarioError(f"{fields.path}.reference: expected a signal name, got {reference!r}")
     options = {key: fields.integer(key, default, minimum=1, unit="samples") for key, default in
                (("order", 10), ("window", 20), ("hold", 3), ("confirm", 10))}
     options |= {key: fields.number(key, positive=True) for key in ("mu", "eps0", "r0")}
-    return observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
-                                      reference=None if reference is None else _group(plant, (reference,), "",
-                                                                                      "input"), **options))
+    block = observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
+                                       reference=None if reference is None else _group(plant, (reference,), "",
+                                                                                       "input"), **options))
+    fixed = ", ".join(f"{key} = {options[key]:g}" for key in ("mu", "eps0", "r0"))
+    return replace(block, description=f"{block.description}; here {fixed}")
+
+
+def _select(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.blocks import select
+
+    flag = _names(fields, "flag", size=1)[0]
+    output = _names(fields, "output")
+    on, off = (_names(fields, key, size=len(output)) for key in ("on", "off"))
+    units = set(_group(plant, on + off, fields.path, "read").units) - {""}  # the plant's units of on and off
+    return select(name, flag=flag, on=on, off=off, output=output, unit=units.pop() if len(units) == 1 else "")
 
 
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
-          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms}
+          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
+          "select": _select}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

@@ -8,12 +8,15 @@ scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant'
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
 ``d``: constant disturbances), ``[noise]`` (output = standard deviation, the sensors'
-specification, acting the whole run), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
+specification, acting the whole run; disturbance = standard deviation of a white disturbance held
+over each sample and added to ``d``, drawn from its own seeded stream,
+:func:`~uvsym.sim.loop.disturbance_draws`), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
 ``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
 estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
 ``sensor`` = an output name, ``kind``, ``value`` and the profile fields of vehicle scenarios),
 ``[substitutions]`` (``channel = { by = "signal", when = "flag signal" }``: while the flag is set
-every block reading channel reads the substitute, from the next sample) and ``[[detectors]]``:
+every block reading channel reads the substitute, from the next sample; a ``select`` block
+switches in the same sample) and ``[[detectors]]``:
 
 - ``type = "threshold"``: ``residuals`` (signal names ``<block>.<signal>``), ``targets`` (the
   input or output each points to), ``isolate`` (the residuals are structured, so the largest one
@@ -91,6 +94,7 @@ class SystemScenario:
     supervisor: FlagSubstitution | None
     detectors: tuple
     substitutions: dict
+    d_noise: np.ndarray | None = None  # (n_d,) standard deviations of the white disturbances; None: none
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -211,7 +215,7 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
         lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
         raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
                             f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
-    return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0])
+    return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0], blocks[monitor].description)
 
 
 def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
@@ -284,12 +288,19 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     initial.done()
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number", "standard deviation of the output's sensor noise (its unit)", "none")
-    noise = {}
+    top.describe("noise.<disturbance>", "number", "standard deviation of a white disturbance, held over each "
+                 "sample (its unit)", "none")
+    noise, d_noise = {}, np.zeros(plant.d.size)
     if noise_fields is not None:
         for channel in list(noise_fields.data):
+            if channel in plant.d.names:
+                d_noise[plant.d.index(channel)] = noise_fields.number(channel, positive=True)
+                continue
             if channel not in plant.y.names:
-                raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
-                                    f"outputs: {', '.join(plant.y.names)}")
+                known = plant.y.names + plant.d.names
+                raise ScenarioError(f"noise.{channel}: unknown output or disturbance of {plant.name}"
+                                    f"{_close(channel, known)}; outputs: {', '.join(plant.y.names)}; disturbances: "
+                                    f"{', '.join(plant.d.names) or 'none'}")
             noise[channel] = noise_fields.number(channel, positive=True)
     blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
     blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
@@ -327,7 +338,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
                           loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                           supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
-                          detectors=tuple(detectors), substitutions=by)
+                          detectors=tuple(detectors), substitutions=by, d_noise=d_noise if d_noise.any() else None)
 
 
 
@@ -338,10 +349,14 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     The result's ``events`` hold every detector's decisions in time order (each names its
     ``detector``), its meta ``detectors`` each detector's design (rule, thresholds, designed rates).
     """
+    from uvsym.sim.loop import disturbance_draws
     from uvsym.sim.system_simulation import run_wired
 
     N = round(scenario.duration / scenario.step)
-    W = loop_inputs(scenario.loop, N, scenario.d, scenario.seed)
+    d = scenario.d
+    if scenario.d_noise is not None:
+        d = d + scenario.d_noise * disturbance_draws(N, scenario.d.size, scenario.seed)
+    W = loop_inputs(scenario.loop, N, d, scenario.seed)
     result = run_wired(scenario.loop, scenario.z0, W, method=method, supervisor=scenario.supervisor,
                        options=options, compiled=compiled, progress=progress, duration=scenario.duration,
                        seed=scenario.seed, actuator_faults=scenario.actuator_faults,
