@@ -56,12 +56,13 @@ def test_a_shipped_scenario_reproduces_the_studys_run(name, study_runs):
         np.testing.assert_allclose(new[group][label], old.result[group][label], rtol=0, atol=1e-9,
                                    err_msg=f"{group}.{label}")
     confirmed = old.supervisor.first("R alarm")
-    detected = [e["t"] for e in new.meta["events"] if e["event"] == "detected"]
+    events = [e for e in new.meta["events"] if e["detector"] == "double_criterion"]
+    detected = [e["t"] for e in events if e["event"] == "detected"]
     if confirmed is None:  # the spike: released as a disturbance, nothing decided
-        assert old.supervisor.first("no R alarm") is not None and new.meta["events"] == []
+        assert old.supervisor.first("no R alarm") is not None and events == []
     else:
         assert detected == [pytest.approx(old.result.t[confirmed.sample], abs=1e-9)]
-        assert [e["target"] for e in new.meta["events"]] == ["psi", "psi"]
+        assert [e["target"] for e in events] == ["psi", "psi"]
 
 
 def test_the_compiled_run_decides_the_same_and_differs_only_in_r_once_latched(study_runs):
@@ -141,3 +142,34 @@ def test_a_scenario_without_faults_decides_nothing():
     table = _table("compass_20deg")
     table["faults"], table["duration"] = [], 60.0
     assert simulate_system_scenario(_parsed(table), compiled=False).meta["events"] == []
+
+
+def test_the_threshold_detectors_sigma_is_the_noise_models():
+    """The error threshold's typed std is e_psi's under the file's [noise], through the loop linearised at
+    its start (the noise model it is designed from), not a value read off a run."""
+    table = _table("compass_20deg")
+    typed = next(d for d in table["detectors"] if d["type"] == "threshold")["std"]
+    for detector in table["detectors"]:
+        detector.pop("std", None)
+    scenario = _parsed(table)
+    computed = next(d for d in scenario.detectors if d.name == "error_threshold").design()["sigma"]
+    assert computed == pytest.approx(typed, rel=1e-9)
+
+
+def test_the_double_criterions_design_names_its_thresholds():
+    design = next(d for d in _parsed(_table("compass_20deg")).detectors if d.name == "double_criterion").design()
+    assert design["sensor"] == "psi" and design["monitor"] == "lms"
+    assert "eps0 = 0.00274156" in design["settings"] and "r0 = 9" in design["settings"]
+    assert "confirm 10" in design["settings"] and "hold 3" in design["settings"]
+
+
+def test_a_detection_and_isolation_at_one_sample_are_one_false_alarm():
+    from uvsym.campaign.metrics import event_metrics
+
+    healthy = {"true_actuator": None, "true_sensor": None, "true_value": None, "onset_s": None, "end_s": None}
+    events = [{"t": 150.6, "event": "detected", "target": "psi", "detector": "dc"},
+              {"t": 150.6, "event": "isolated", "target": "psi", "detector": "dc"},
+              {"t": 150.6, "event": "detected", "target": "psi", "detector": "th"},  # another detector: its own
+              {"t": 170.0, "event": "detected", "target": "psi", "detector": "th"}]
+    assert event_metrics(healthy, events)["false_alarms"] == 3
+    assert event_metrics(healthy, [e for e in events if e["detector"] == "dc"])["false_alarms"] == 1
