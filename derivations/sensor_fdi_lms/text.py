@@ -221,6 +221,9 @@ the error threshold {setpoints['error_threshold']['false_alarms']}. The long hea
 
 {_healthy_table(k["healthy_by_noise"])}
 
+A run of the double criterion holds one false alarm at most (the fault latches): where every run of a
+row alarmed, its rate is a lower bound.
+
 Per case:
 
 {_case_table(k["cases"])}
