@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+import warnings
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from derivations.sensor_fdi_lms import DERIVATION
 from derivations.sensor_fdi_lms.design import DT, EPS0_DEG2, WARM_UP, design
 from derivations.sensor_fdi_lms.experiment import Run, run
 from uvsym.cli import main
-from uvsym.errors import ScenarioError
+from uvsym.errors import ScenarioError, StepSizeWarning
 from uvsym.sim.loop import disturbance_draws, sample_inputs
 from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
 
@@ -159,8 +160,24 @@ def test_the_threshold_detectors_sigma_is_the_noise_models():
 def test_the_double_criterions_design_names_its_thresholds():
     design = next(d for d in _parsed(_table("compass_20deg")).detectors if d.name == "double_criterion").design()
     assert design["sensor"] == "psi" and design["monitor"] == "lms"
-    assert "eps0 = 0.00274156" in design["settings"] and "r0 = 9" in design["settings"]
+    assert design["parameters"] == {"mu": 0.01, "eps0": EPS0_DEG2 * (math.pi / 180.0) ** 2, "r0": 9.0}
     assert "confirm 10" in design["settings"] and "hold 3" in design["settings"]
+
+
+def test_a_step_beyond_the_mean_square_bound_of_the_runs_input_power_warns(tmp_path):
+    """mu M P_u >= 1 with P_u the mean square of the command the filter regresses on: StepSizeWarning
+    naming the monitor's mu and the bound (the paper's mu stays silent)."""
+    table = _table("compass_20deg")
+    table["duration"], table["faults"][0]["onset"] = 24.0, 4.0
+    table["blocks"][1].update(order=10, mu=1e5)
+    with pytest.warns(StepSizeWarning, match=r"lms\.mu = 100000 is at or beyond the mean-square stability bound "
+                                             r"1 / \(M P_u\) = [0-9.e+]+ \(M = 10"):
+        u = simulate_system_scenario(_parsed(table), compiled=False)["heading"]["u"]
+    assert 1e5 * 10 * np.mean(u ** 2) >= 1.0  # the bound the warning names, from the record itself
+    table["blocks"][1]["mu"] = 0.01
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", StepSizeWarning)
+        simulate_system_scenario(_parsed(table), compiled=False)
 
 
 def test_a_detection_and_isolation_at_one_sample_are_one_false_alarm():

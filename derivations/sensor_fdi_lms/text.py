@@ -407,6 +407,8 @@ $\\mu M P_u < 1$ in exact rational arithmetic on the samples' binary values (the
 independence theory, Widrow & Stearns 1985, $\\operatorname{{tr}} R_{{UU}} = M P_u$). The negative control
 $\\mu$ = {r['negative_factor']:g} / (M P_u) is refuted as it must be: exact $\\mu M P_u$ =
 {1 - negative['margin']:g} (margin {negative['margin']:g}).
+`uvsym simulate` warns (`StepSizeWarning`, with the bound) when a scenario's $\\mu$ is at or beyond the
+bound of its own run's input power (the `lms` detector checks it on the record).
 
 ## Generated C
 

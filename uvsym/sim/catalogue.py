@@ -27,8 +27,6 @@ select           flag, on, off, output (signal names; on, off, output one name o
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 from uvsym.codegen.cache import memoized
@@ -187,11 +185,9 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
     options = {key: fields.integer(key, default, minimum=1, unit="samples") for key, default in
                (("order", 10), ("window", 20), ("hold", 3), ("confirm", 10))}
     options |= {key: fields.number(key, positive=True) for key in ("mu", "eps0", "r0")}
-    block = observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
-                                       reference=None if reference is None else _group(plant, (reference,), "",
-                                                                                       "input"), **options))
-    fixed = ", ".join(f"{key} = {options[key]:g}" for key in ("mu", "eps0", "r0"))
-    return replace(block, description=f"{block.description}; here {fixed}")
+    return observer_block(lms_monitor(measured, regressor, dt=dt, name=name,
+                                      reference=None if reference is None else _group(plant, (reference,), "",
+                                                                                      "input"), **options))
 
 
 def _select(fields: Fields, plant: System, dt: float, name: str) -> Block:

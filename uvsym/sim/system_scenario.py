@@ -215,7 +215,13 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
         lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
         raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
                             f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
-    return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0], blocks[monitor].description)
+    block, regressor = blocks[monitor], blocks[monitor].reads.names[1]
+    if "." not in regressor:  # the logged signal it names: the publishing block's, else the plant input
+        regressor = next((f"{b.name}.{regressor}" for b in scenario_loop.blocks if regressor in b.publishes.names),
+                         f"u.{regressor}")
+    order = sum(n.startswith("C_") for n in block.state.names)  # the filter's weights C_1 .. C_M
+    return DoubleCriterion(name, monitor, block.reads.names[0], block.description, block.parameters, regressor,
+                           order)
 
 
 def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
