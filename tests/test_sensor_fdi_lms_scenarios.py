@@ -190,3 +190,25 @@ def test_a_detection_and_isolation_at_one_sample_are_one_false_alarm():
               {"t": 170.0, "event": "detected", "target": "psi", "detector": "th"}]
     assert event_metrics(healthy, events)["false_alarms"] == 3
     assert event_metrics(healthy, [e for e in events if e["detector"] == "dc"])["false_alarms"] == 1
+
+
+def test_the_campaign_covers_what_the_issue_asks_and_every_run_is_valid():
+    """Every run's scenario parses (load_campaign validates them all); sizes span 1 to 30 deg, both signs,
+    the profiles and kinds the issue lists, noise at 1, 2 and 3 times the scenario's, healthy runs
+    with set-point changes and long healthy runs."""
+    from derivations.sensor_fdi_lms.campaign import CAMPAIGN
+    from uvsym.campaign import load_campaign
+
+    runs = load_campaign(CAMPAIGN).runs
+    faults = [r.scenario["faults"][0] for r in runs if r.scenario["faults"]]
+    assert {(f.get("kind", "bias"), f.get("profile", "step")) for f in faults} >= {
+        ("bias", "step"), ("bias", "ramp"), ("bias", "incipient"), ("bias", "intermittent"), ("drift", "step"),
+        ("stuck", "step")}
+    assert any("end" in f for f in faults)  # pulses, down to one sample
+    sizes = sorted(math.degrees(f["value"]) for f in faults if f.get("kind", "bias") == "bias")
+    assert sizes[0] < 0 and min(abs(s) for s in sizes) == pytest.approx(1.0) and sizes[-1] == pytest.approx(30.0)
+    noise = _table("compass_20deg")["noise"]["psi"]
+    assert sorted({r.scenario["noise"]["psi"] / noise for r in runs}) == pytest.approx([1.0, 2.0, 3.0])
+    healthy = [r for r in runs if not r.scenario["faults"]]
+    assert any(len(r.scenario["setpoints"][0]["values"]) > 1 for r in healthy)
+    assert sum(r.scenario["duration"] for r in healthy) >= 10 * 3600.0
