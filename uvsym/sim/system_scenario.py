@@ -25,7 +25,8 @@ switches in the same sample) and ``[[detectors]]``:
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
-- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions.
+- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions, and a
+  StepSizeWarning when the block's mu is at or beyond the mean-square bound of the run's input power.
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
