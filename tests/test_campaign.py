@@ -404,3 +404,13 @@ def test_a_shipped_study_scenario_runs_in_a_campaign_by_its_name(tmp_path):
     campaign = load_campaign(_write(tmp_path, text))
     assert [r.scenario["faults"][0]["value"] for r in campaign.runs] == [2.0, 10.0]
     assert all(r.scenario["plant"].endswith(":hover_plant") for r in campaign.runs)
+
+
+def test_a_study_scenario_is_found_by_name(tmp_path):
+    """compass_10deg is shipped with the sensor-fdi-lms study: a campaign names it as it names a vehicle
+    scenario; a misspelt name is refused with the shipped ones listed."""
+    text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1, 2]\n'
+    campaign = load_campaign(_write(tmp_path, text))
+    assert [r.scenario["plant"] for r in campaign.runs] == ["rov_yaw", "rov_yaw"]
+    with pytest.raises(CampaignError, match=r"no shipped scenario 'compass_11deg'; shipped: .*compass_10deg"):
+        load_campaign(_write(tmp_path, text.replace("compass_10deg", "compass_11deg")))

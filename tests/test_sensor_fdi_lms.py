@@ -1,4 +1,4 @@
-"""The LMS compass-fault study: the paper's runs (shortened), the scenario fields, the shipped scenarios."""
+"""The LMS compass-fault study: the paper's runs (shortened); its scenario files: test_sensor_fdi_lms_scenarios."""
 
 from __future__ import annotations
 
@@ -7,9 +7,6 @@ import pytest
 
 from derivations.sensor_fdi_lms.design import FAULT_SAMPLE, SET_POINT_DEG, design, heading_gain
 from derivations.sensor_fdi_lms.experiment import Run, first_sample, run
-from derivations.sensor_fdi_lms.scenario import run_from_table
-from uvsym.cli import main
-from uvsym.errors import ScenarioError, StepSizeWarning
 
 SHORT = {"warm_up": 100, "record": 160}
 SETTLE = {"warm_up": 100, "record": 320}  # the nonlinear damping makes the loop settle in about 40 s
@@ -58,43 +55,3 @@ def test_heading_gain_sets_the_natural_frequency_of_the_linearised_loop():
     kp = heading_gain(plant, 0.7)
     closed = lin.A - lin.B @ np.array([[kp, 0.0]])
     assert np.prod(np.linalg.eigvals(closed)).real == pytest.approx(0.7 ** 2, rel=1e-9)
-
-
-@pytest.mark.parametrize("table, field", [
-    ({"fault": {"sensor": "depth"}}, "fault.sensor"),
-    ({"fault": {"onset_sample": 400}}, "fault.onset_sample"),
-    ({"fault": {"onset_sample": 50}, "run": {"record_samples": 40}}, "fault.onset_sample"),
-    ({"monitor": {"order": 0}}, "monitor.order"),
-    ({"monitor": {"mu": 0.0}}, "monitor.mu"),
-    ({"monitor": {"mu": -0.01}}, "monitor.mu"),
-    ({"monitor": {"eps0_deg2": 0.0}}, "monitor.eps0_deg2"),
-    ({"monitor": {"r0": -1}}, "monitor.r0"),
-    ({"monitor": {"order": 2.5}}, "monitor.order"),
-    ({"fault": {"profile": "wobble"}}, "fault.profile"),
-    ({"fault": {"size": 3}}, "fault.size"),
-    ({"run": {"ftc": "yes"}}, "run.ftc"),
-    ({"noise": {}}, "noise"),
-])
-def test_bad_scenario_fields_are_named(table, field):
-    with pytest.raises(ScenarioError, match=field.replace(".", r"\.")):
-        run_from_table(table)
-
-
-def test_scenario_fields_reach_the_run():
-    spec = run_from_table({"fault": {"size_deg": 12.5, "onset_sample": 30, "profile": "ramp", "length_samples": 5},
-                           "run": {"ftc": False, "seed": 4}, "monitor": {"order": 10, "mu": 0.02}})
-    assert (spec.size_deg, spec.onset, spec.profile, spec.length, spec.ftc, spec.seed, spec.order, spec.mu) == \
-        (12.5, 30, "ramp", 5, False, 4, 10, 0.02)
-    profile = spec.profile_object()
-    assert profile.kind == "ramp" and profile.onset == pytest.approx((spec.warm_up + 30) * 0.2)
-
-
-def test_uvsym_simulate_runs_a_study_scenario_and_warns_beyond_the_step_bound(tmp_path, capsys):
-    scenario = tmp_path / "beyond.toml"
-    scenario.write_text('study = "sensor-fdi-lms"\n[fault]\nsize_deg = 20.0\n[run]\nftc = false\n'
-                        'warm_up_samples = 20\nrecord_samples = 100\n[monitor]\norder = 10\nmu = 1e5\n')
-    beyond = r"monitor.mu = 100000 is at or beyond the mean-square stability bound 1 / \(M P_u\)"
-    with pytest.warns(StepSizeWarning, match=beyond):
-        assert main(["simulate", str(scenario), "--out", str(tmp_path / "run.npz")]) == 0
-    assert (tmp_path / "run.npz").exists()
-    assert "sensor-fdi-lms" in capsys.readouterr().out

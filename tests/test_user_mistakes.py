@@ -8,7 +8,6 @@ import tomllib
 import pytest
 
 import uvsym
-from derivations.sensor_fdi_lms.scenario import run_from_table
 from uvsym.errors import ArgumentError, FaultError, ObserverError, ScenarioError, SimulationError
 from uvsym.faults import Profile, SensorFault
 from uvsym.sim import open_loop, simulate_system
@@ -18,13 +17,6 @@ from uvsym.sim.simulation import simulate_scenario
 
 def _docking() -> dict:
     return tomllib.loads(shipped_scenarios()["docking_faults"].read_text())
-
-
-def test_an_lms_scenario_without_a_fault_table_has_no_fault_and_a_negative_seed_is_named():
-    assert run_from_table({"run": {"seed": 3}}).size_deg is None
-    assert run_from_table({"fault": {"onset_sample": 90}}).size_deg == 30.0  # a [fault] table: the paper's fault
-    with pytest.raises(ScenarioError, match=r"run\.seed: must be at least 0, got -1"):
-        run_from_table({"run": {"seed": -1}})
 
 
 def test_misspelt_fields_are_pointed_at():

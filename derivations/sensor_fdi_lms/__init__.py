@@ -1,7 +1,7 @@
 """Sensor-fault diagnosis with an adaptive LMS-FIR filter and fault-tolerant heading hold (paper 001).
 
 ``uvsym report sensor-fdi-lms``, ``uvsym verify sensor-fdi-lms``, ``uvsym codegen sensor-fdi-lms -o DIR``,
-``uvsym simulate derivations/sensor_fdi_lms/scenarios/compass_30deg.toml``.
+``uvsym simulate compass_30deg`` (the scenario files of ``scenarios/``).
 """
 
 from pathlib import Path
@@ -9,7 +9,6 @@ from pathlib import Path
 from derivations.sensor_fdi_lms.claims import lms_claims
 from derivations.sensor_fdi_lms.observer_sets import lms_set
 from derivations.sensor_fdi_lms.report import build
-from derivations.sensor_fdi_lms.scenario import simulate
 from uvsym.derivation import Derivation
 
 __all__ = ["DERIVATION"]
@@ -22,6 +21,5 @@ DERIVATION = Derivation(
     build=build,
     claims=lms_claims,
     observer_sets={"sensor-fdi-lms": lms_set},
-    simulate=simulate,
     scenarios={path.stem: path for path in sorted(SCENARIOS.glob("*.toml"))},
 )

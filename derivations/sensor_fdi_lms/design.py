@@ -33,6 +33,7 @@ from uvsym.observers.lms_supervisor import switch_flag
 from uvsym.sim import observer_block
 from uvsym.sim.blocks import select
 from uvsym.sim.feedback import open_loop, pid
+from uvsym.sim.loop import disturbance_draws
 from uvsym.systems.signals import signals
 from uvsym.systems.system import System
 
@@ -123,5 +124,6 @@ def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0:
 
 
 def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:
-    """(samples + 1, 1) white yaw torque (N m), seeded."""
-    return sigma * np.random.default_rng(seed).standard_normal((samples + 1, 1))
+    """(samples + 1, 1) white yaw torque (N m), seeded: the draws of a scenario's ``[noise] tau_d``
+    (:func:`uvsym.sim.loop.disturbance_draws`, independent of the compass noise's)."""
+    return sigma * disturbance_draws(samples, 1, seed)

@@ -9,6 +9,7 @@ import numpy as np
 
 from derivations.papers import paper
 from derivations.sensor_fdi_lms import design as D
+from derivations.sensor_fdi_lms.campaign import campaign_results
 from derivations.sensor_fdi_lms.claims import NEGATIVE_FACTOR, healthy_input, lms_claims
 from derivations.sensor_fdi_lms.experiment import Run, first_sample, run
 from derivations.sensor_fdi_lms.figures import criteria_figure, delay_figure, heading_figure, roc_figure
@@ -147,12 +148,13 @@ def _learning(u: np.ndarray, outcome) -> dict:
 
 
 def build(out_dir: Path, progress) -> None:
-    """Run the reproduction and the detection study, export C, check the claims, write the report."""
+    """Run the reproduction, the detection study and the campaign, export C, check the claims, write the report."""
     outcomes, summaries = _runs(progress)
     robustness = _robustness(progress)
     steps = _steps(progress)
     progress(f"detection study: {2 * 100} runs over noise seeds, ROC over thresholds")
     study = detection_study()
+    campaign = campaign_results(out_dir, progress)
     progress("C package of the monitor: write, compile, compare")
     c = c_package(lms_set(), out_dir / "c")
     progress("machine-checked claims")
@@ -186,7 +188,7 @@ def build(out_dir: Path, progress) -> None:
         "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
         "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
                   "nominal": study.delays, "r0_grid": list(R0_GRID)},
-        "paper": PAPER, "c": c, "claims": claims, "negative_factor": NEGATIVE_FACTOR,
+        "campaign": campaign, "paper": PAPER, "c": c, "claims": claims, "negative_factor": NEGATIVE_FACTOR,
         "choices": {"eps0_deg2": D.EPS0_DEG2, "r0": D.R0, "window": D.WINDOW, "hold": D.HOLD, "confirm": D.CONFIRM,
                     "bandwidth_rad_per_s": D.BANDWIDTH, "compass_noise_deg": D.COMPASS_NOISE_DEG,
                     "torque_noise_N_m": D.TORQUE_NOISE, "warm_up": D.WARM_UP, "record": D.RECORD,

@@ -11,7 +11,8 @@ noise acting for the whole run is the sensors' specification, not a fault (as fo
 whose noise levels it sets), so a run with only such noise has no fault. The fault's window runs
 from the onset to the first "cleared" event at or after its end (a fault without an end lasts
 the run). An alarm (detected, isolated, identified) outside the window, or in a run
-without a fault, is a false alarm.
+without a fault, is a false alarm; the alarms one detector publishes at one time are one decision
+(a monitor that detects and isolates at once raises one false alarm, not two).
 """
 
 from __future__ import annotations
@@ -127,7 +128,7 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "isolation_delay_s": isolations[0]["t"] - onset if isolations else None,
         "identified_value": value,
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
-        "false_alarms": sum(e["event"] in ALARMS and not in_window(e) for e in events),
+        "false_alarms": len({(e.get("detector"), e["t"]) for e in events if e["event"] in ALARMS and not in_window(e)}),
         "ambiguous": any(e["event"] == "ambiguous" for e in events),
         "unexcited": any(e["event"] == "unexcited" and e.get("target") in (target, None) for e in events),
     }

@@ -140,13 +140,28 @@ class ResidualThreshold:
 
 @dataclass(frozen=True)
 class DoubleCriterion:
-    """The LMS monitor ``monitor``'s fault flag on ``sensor`` as events (module docstring)."""
+    """The LMS monitor ``monitor``'s fault flag on ``sensor`` as events (module docstring).
+
+    settings: the monitor's order, window, hold and confirm (its block's description); parameters:
+    its fixed (mu, eps0, r0); regressor, order: the input its filter regresses on and M. Deciding on
+    a record warns (StepSizeWarning) when mu is at or beyond the mean-square bound ``1 / (M P_u)``
+    of the record's input power P_u (:func:`uvsym.observers.lms.check_mu`)."""
 
     name: str
     monitor: str
     sensor: str
+    settings: str = ""
+    parameters: tuple[tuple[str, float], ...] = ()
+    regressor: str | None = None
+    order: int = 0
 
     def decide(self, result) -> list[Event]:
+        from uvsym.observers.lms import check_mu
+
+        mu = dict(self.parameters).get("mu")
+        if mu is not None and self.regressor is not None:
+            u = read_signal(result, self.regressor)
+            check_mu(mu, self.order, float(np.mean(u ** 2)), what=f"{self.monitor}.mu")
         t = np.asarray(result.t, dtype=float)
         flag = read_signal(result, f"{self.monitor}.fault_{self.sensor}") > 0.5
         changes = np.flatnonzero(np.diff(np.concatenate([[False], flag]).astype(int)))
@@ -162,7 +177,8 @@ class DoubleCriterion:
 
     def design(self) -> dict:
         return {"detector": self.name, "rule": "LMS double criterion (eps^2 > eps0 confirmed by R > r0)",
-                "monitor": self.monitor, "sensor": self.sensor}
+                "monitor": self.monitor, "sensor": self.sensor, "settings": self.settings,
+                "parameters": dict(self.parameters)}
 
 
 

@@ -104,15 +104,12 @@ def simulate_batch(scenarios: Sequence, *, lanes: int = LANES, substeps: int = 1
 
 def _system_lanes(scenarios: list, lanes: int, compiled: bool) -> list[SimResult]:
     """Scenarios over one shared wired step, in lanes; each result as simulate_system_scenario gives it."""
-    from uvsym.sim.system_scenario import decided, scenario_meta_arguments
-    from uvsym.sim.system_simulation import loop_inputs, wired_meta
+    from uvsym.sim.system_scenario import decided, scenario_inputs, scenario_meta_arguments
+    from uvsym.sim.system_simulation import wired_meta
 
-    runs = []
-    for scenario in scenarios:
-        N = round(scenario.duration / scenario.step)
-        meta = wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario))
-        runs.append(PreparedRun(scenario.loop, scenario.z0, loop_inputs(scenario.loop, N, scenario.d, scenario.seed),
-                                None, meta))
+    runs = [PreparedRun(scenario.loop, scenario.z0, scenario_inputs(scenario), None,
+                        wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario)))
+            for scenario in scenarios]
     results = run_lanes(runs, lanes=lanes, compiled=compiled, names=[s.name for s in scenarios])
     return [decided(scenario, result) for scenario, result in zip(scenarios, results)]
 

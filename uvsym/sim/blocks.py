@@ -37,7 +37,8 @@ class Block:
     names); s0: (n_s,) initial state; dt: the sample period (s) the step was designed for, None
     for a block valid at any rate; init(r0 (n_r,)) -> s0: the initial state from the first
     sample's reads, or None to start at s0; source: the Observer the block runs (for claims about
-    it, :mod:`uvsym.scenario_exports`), None for other blocks.
+    it, :mod:`uvsym.scenario_exports`), None for other blocks; parameters: (name, value) of the parameters its step
+    holds fixed (an observer's p, :func:`observer_block`), for what reads the block's design.
     """
 
     name: str
@@ -50,6 +51,7 @@ class Block:
     init: Callable | None = None
     description: str = ""
     source: object = None
+    parameters: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self):
         check_name(self.name, "block", WiringError)
@@ -123,7 +125,8 @@ def renamed(blk: Block, reads: dict[str, str] | None = None, publishes: dict[str
 
 def observer_block(obs: Observer, p=None, *, s0=None) -> Block:
     """An :class:`~uvsym.observers.base.Observer` as a block: reads ``obs.reads_y + obs.reads_u``,
-    publishes ``obs.publishes``, parameters fixed at p (default ``obs.p0``), ``dt = obs.dt``.
+    publishes ``obs.publishes``, parameters fixed at p (default ``obs.p0``; the block's ``parameters``),
+    ``dt = obs.dt``.
 
     It starts at s0 if given, else at ``obs.init(y0, u0, p)`` of its first reads (zeros without init).
     """
@@ -134,9 +137,10 @@ def observer_block(obs: Observer, p=None, *, s0=None) -> Block:
         def init(r0):
             return obs.initial_state(r0[:n_y], r0[n_y:], p)
 
-    return block(obs.name, step=lambda s, r: obs.step(s, r[:n_y], r[n_y:], ca.DM(p)), state=obs.state,
-                 reads=obs.reads_y + obs.reads_u, publishes=obs.publishes, s0=s0, dt=obs.dt, init=init,
-                 description=obs.description, source=obs)
+    built = block(obs.name, step=lambda s, r: obs.step(s, r[:n_y], r[n_y:], ca.DM(p)), state=obs.state,
+                  reads=obs.reads_y + obs.reads_u, publishes=obs.publishes, s0=s0, dt=obs.dt, init=init,
+                  description=obs.description, source=obs)
+    return replace(built, parameters=tuple(zip(obs.params.names, (float(v) for v in np.ravel(p)))))
 
 
 def select(name: str, *, flag: str, on: str | Sequence[str], off: str | Sequence[str], output: str | Sequence[str],

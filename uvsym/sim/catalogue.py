@@ -23,6 +23,9 @@ uio_bank         poles (F's n eigenvalues), measured (outputs), decouple (distur
                  per input, publishing r_<input>_<output> (:mod:`uvsym.sim.uio_block`)
 hybrid           z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
                  estimator), model, x0 (:mod:`uvsym.sim.hybrid_block`)
+select           flag, on, off, output (signal names; on, off, output one name or n each): a
+                 switch of the same sample, ``output = flag ? on : off`` (substitution from the
+                 sample the flag rises; ``[substitutions]`` switch from the next sample)
 ===============  ==============================================================================
 """
 
@@ -191,7 +194,7 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
     measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
     regressor = _group(plant, _names(fields, "regressor", size=1), fields.path, "input")
-    reference = fields.raw("reference", None, "string", "signal subtracted before regression", "none")
+    reference = fields.raw("reference", None, "string", "signal subtracted before regression")
     if reference is not None and not isinstance(reference, str):
         raise ScenarioError(f"{fields.path}.reference: expected a signal name, got {reference!r}")
     options = {key: fields.integer(key, default, minimum=1, unit="samples") for key, default in
@@ -208,9 +211,20 @@ def _uio_bank(fields: Fields, plant: System, dt: float, name: str) -> Block:
     return uio_bank_block(fields, plant, dt, name)
 
 
+def _select(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.blocks import select
+
+    flag = _names(fields, "flag", size=1)[0]
+    output = _names(fields, "output")
+    on, off = (_names(fields, key, size=len(output)) for key in ("on", "off"))
+    units = set(_group(plant, on + off, fields.path, "read").units) - {""}  # the plant's units of on and off
+    return select(name, flag=flag, on=on, off=off, output=output, unit=units.pop() if len(units) == 1 else "")
+
+
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
-          "uio_bank": _uio_bank, "hybrid": hybrid_block}
+          "uio_bank": _uio_bank, "hybrid": hybrid_block,
+          "select": _select}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

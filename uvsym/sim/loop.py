@@ -14,7 +14,7 @@ import numpy as np
 
 from uvsym.errors import SimulationError
 
-__all__ = ["SampledLoop", "fault_summary", "logged_signals", "per_sample", "sample_inputs"]
+__all__ = ["SampledLoop", "disturbance_draws", "fault_summary", "logged_signals", "per_sample", "sample_inputs"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -71,6 +71,12 @@ def sample_inputs(n_w: int, N: int, dt: float, n_noise: int, seed: int) -> np.nd
     W[:, 0] = dt * np.arange(N + 1)
     W[:, 1:1 + n_noise] = np.random.default_rng(seed).standard_normal((N + 1, n_noise))
     return W
+
+
+def disturbance_draws(N: int, n_d: int, seed: int) -> np.ndarray:
+    """(N + 1, n_d) standard normal draws behind white disturbances, one row per sample, from the
+    stream ``(seed, 1)``: independent of the sensor noise draws of :func:`sample_inputs` (stream ``seed``)."""
+    return np.random.default_rng((seed, 1)).standard_normal((N + 1, n_d))
 
 
 def fault_summary(fault, target: str) -> dict:

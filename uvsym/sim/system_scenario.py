@@ -13,12 +13,15 @@ over it, instead of its constant), ``[noise]`` (output = standard deviation of G
 output = ``{ uniform = bound }`` for noise uniform in ``[-bound, bound]``: the sensors'
 specification, acting the whole run; the threshold calibration linearises the noise at its draw 0,
 so it takes uniform noise for Gaussian noise of standard deviation ``bound sqrt(2 / pi)``, above
-its true ``bound / sqrt 3``), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
+its true ``bound / sqrt 3``; disturbance = standard deviation of a white disturbance held over
+each sample and added to ``d``, drawn from its own seeded stream,
+:func:`~uvsym.sim.loop.disturbance_draws`), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
 ``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
 estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
 ``sensor`` = an output name, ``kind``, ``value`` and the profile fields of vehicle scenarios),
 ``[substitutions]`` (``channel = { by = "signal", when = "flag signal" }``: while the flag is set
-every block reading channel reads the substitute, from the next sample) and ``[[detectors]]``:
+every block reading channel reads the substitute, from the next sample; a ``select`` block
+switches in the same sample) and ``[[detectors]]``:
 
 - ``type = "threshold"``: ``residuals`` (signal names ``<block>.<signal>``), ``targets`` (the
   input or output each points to), ``isolate`` (the residuals are structured, so the largest one
@@ -28,7 +31,8 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at the plant's operating point, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
-- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions;
+- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions, and a
+  StepSizeWarning when the block's mu is at or beyond the mean-square bound of the run's input power;
 - ``type = "zonotope_bands"``: ``bank`` (a uio_bank block's name), ``noise_bound`` and
   ``initial_error`` (the stated bounds), ``generators``, ``reduction``, ``horizon``,
   ``isolation_window``, ``release``: band exits of the bank, isolation by their pattern
@@ -108,6 +112,7 @@ class SystemScenario:
     supervisor: FlagSubstitution | None
     detectors: tuple
     substitutions: dict
+    d_noise: np.ndarray | None = None  # (n_d,) standard deviations of the white disturbances; None: none
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -278,7 +283,13 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
         lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
         raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
                             f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
-    return DoubleCriterion(name, monitor, blocks[monitor].reads.names[0])
+    block, regressor = blocks[monitor], blocks[monitor].reads.names[1]
+    if "." not in regressor:  # the logged signal it names: the publishing block's, else the plant input
+        regressor = next((f"{b.name}.{regressor}" for b in scenario_loop.blocks if regressor in b.publishes.names),
+                         f"u.{regressor}")
+    order = sum(n.startswith("C_") for n in block.state.names)  # the filter's weights C_1 .. C_M
+    return DoubleCriterion(name, monitor, block.reads.names[0], block.description, block.parameters, regressor,
+                           order)
 
 
 def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
@@ -395,12 +406,21 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number or table", "standard deviation of the output's Gaussian sensor noise, "
                  "or { uniform = bound } (its unit)", "none")
-    noise = {}
+    top.describe("noise.<disturbance>", "number", "standard deviation of a white disturbance, held over each "
+                 "sample (its unit)", "none")
+    noise, d_noise = {}, np.zeros(plant.d.size)
     if noise_fields is not None:
         for channel in list(noise_fields.data):
+            if channel in plant.d.names:
+                d_noise[plant.d.index(channel)] = Fields(noise_fields.data, noise_fields.path).number(
+                    channel, positive=True)
+                noise_fields.used.add(channel)
+                continue
             if channel not in plant.y.names:
-                raise ScenarioError(f"noise.{channel}: unknown output of {plant.name}{_close(channel, plant.y.names)}; "
-                                    f"outputs: {', '.join(plant.y.names)}")
+                known = plant.y.names + plant.d.names
+                raise ScenarioError(f"noise.{channel}: unknown output or disturbance of {plant.name}"
+                                    f"{_close(channel, known)}; outputs: {', '.join(plant.y.names)}; disturbances: "
+                                    f"{', '.join(plant.d.names) or 'none'}")
             noise[channel] = _noise(Fields(noise_fields.data, noise_fields.path), channel)  # no per-plant rows
             noise_fields.used.add(channel)
     blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
@@ -440,7 +460,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
                           loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                           supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
-                          detectors=tuple(detectors), substitutions=by)
+                          detectors=tuple(detectors), substitutions=by, d_noise=d_noise if d_noise.any() else None)
 
 
 
@@ -453,11 +473,23 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     """
     from uvsym.sim.system_simulation import run_wired
 
-    N = round(scenario.duration / scenario.step)
-    W = loop_inputs(scenario.loop, N, scenario.d, scenario.seed)
-    result = run_wired(scenario.loop, scenario.z0, W, method=method, supervisor=scenario.supervisor,
-                       options=options, compiled=compiled, progress=progress, **scenario_meta_arguments(scenario))
+    result = run_wired(scenario.loop, scenario.z0, scenario_inputs(scenario), method=method,
+                       supervisor=scenario.supervisor, options=options, compiled=compiled, progress=progress,
+                       **scenario_meta_arguments(scenario))
     return decided(scenario, result)
+
+
+def scenario_inputs(scenario: SystemScenario) -> np.ndarray:
+    """W (N + 1, n_w) of the scenario's run (:func:`~uvsym.sim.system_simulation.loop_inputs`): its
+    disturbances (constant or scheduled) plus its white disturbance noise, its seeded sensor-noise
+    draws and its faults' numbers."""
+    from uvsym.sim.loop import disturbance_draws
+
+    N = round(scenario.duration / scenario.step)
+    d = scenario.d
+    if scenario.d_noise is not None:
+        d = d + scenario.d_noise * disturbance_draws(N, scenario.plant.d.size, scenario.seed)
+    return loop_inputs(scenario.loop, N, d, scenario.seed)
 
 
 def scenario_meta_arguments(scenario: SystemScenario) -> dict:
