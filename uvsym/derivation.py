@@ -19,7 +19,8 @@ What a derivation implements:
 - ``simulate``, optional: ``simulate(table, name=..., progress=..., method=None) -> SimResult`` runs
   a scenario of this study given as the parsed TOML ``table`` (without its ``study`` key); it
   validates every field and raises :class:`~uvsym.errors.ScenarioError` naming the field;
-- ``scenarios``, optional: shipped example scenario name -> TOML path (each with ``study = NAME``).
+- ``scenarios``, optional: shipped example scenario name -> TOML path (a scenario file naming its
+  ``plant``, run by ``uvsym simulate NAME``; one with ``study = NAME`` needs ``simulate``).
 
 What it gets for free:
 
@@ -76,8 +77,6 @@ class Derivation:
         if not isinstance(self.scenarios, Mapping):
             raise DerivationError(f"derivation {self.name!r}: scenarios must map names to TOML paths, "
                                   f"got {type(self.scenarios).__name__}")
-        if self.scenarios and self.simulate is None:
-            raise DerivationError(f"derivation {self.name!r}: ships scenarios but has no simulate")
         parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
                  **({} if self.simulate is None else {"simulate": self.simulate}),
                  **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}

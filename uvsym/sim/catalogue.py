@@ -19,6 +19,11 @@ luenberger       decay (1/s, LMI design certified in exact arithmetic) or gain (
 ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
 lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
                  hold, confirm (samples)
+autopilot        waypoints, lookahead, turn_radius, acceptance, speed, speed_loop, heading_loop,
+                 mix, reads, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
+mmae             filter (ukf, ekf), models (hypothesis = inputs with an efficiency state), q, r,
+                 p0, x0, efficiency_p0, walk_std, floor, prior, reset, steps, alpha, beta, kappa
+                 (:mod:`uvsym.observers.mmae_design`)
 ===============  ==============================================================================
 """
 
@@ -187,8 +192,21 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
                                                                                       "input"), **options))
 
 
+def _autopilot(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.autopilot import autopilot_block
+
+    return autopilot_block(fields, plant, dt, name)
+
+
+def _mmae(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.observers.mmae_design import designed_bank
+
+    return observer_block(designed_bank(fields, plant, dt, name))
+
+
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
-          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms}
+          "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
+          "autopilot": _autopilot, "mmae": _mmae}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

@@ -7,7 +7,9 @@ Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
-``d``: constant disturbances), ``[noise]`` (output = standard deviation, the sensors'
+``d``: constant disturbances), ``[disturbance]`` (``uniform``: a table of disturbance = amplitude
+a, drawn every sample as ``d + a U(-1, 1)``; ``seed``: of those draws, independent of the noise
+draws), ``[noise]`` (output = standard deviation, the sensors'
 specification, acting the whole run), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
 ``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
 estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
@@ -22,7 +24,12 @@ every block reading channel reads the substitute, from the next sample) and ``[[
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at its initial state, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
   ``release`` (samples), ``ignore_before`` (s);
-- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions.
+- ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions;
+- ``type = "mmae"``: ``bank`` (an mmae block's name), ``threshold`` (probability, default 0.9),
+  ``dwell`` (samples, default 1), ``settle`` (samples, default 20) and ``resolution`` (default
+  0.02: the efficiency estimate is published once it stays within it over settle samples),
+  ``ignore_before`` (s), ``kind`` (default proportional): the
+  bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`).
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
@@ -39,6 +46,7 @@ import numpy as np
 
 from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import DoubleCriterion, ResidualThreshold
+from uvsym.diagnosis.hypotheses import mmae_detector
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
@@ -51,7 +59,7 @@ from uvsym.sim.system_simulation import initial_state, loop_inputs
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
-__all__ = ["SystemScenario", "FlagSubstitution", "parse_system_scenario", "is_system_scenario",
+__all__ = ["SystemScenario", "FlagSubstitution", "RandomDisturbance", "parse_system_scenario", "is_system_scenario",
            "simulate_system_scenario", "parse_any_scenario", "simulate_any_scenario", "DETECTORS"]
 
 def is_system_scenario(table: dict) -> bool:
@@ -91,6 +99,7 @@ class SystemScenario:
     supervisor: FlagSubstitution | None
     detectors: tuple
     substitutions: dict
+    random_disturbance: RandomDisturbance | None = None
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -99,6 +108,31 @@ class SystemScenario:
     @property
     def output_labels(self) -> tuple[str, ...]:
         return self.plant.y.names
+
+
+@dataclass(frozen=True)
+class RandomDisturbance:
+    """Disturbances drawn every sample: ``amplitude * U(-1, 1)`` (n_d,) per row, from
+    ``numpy.random.default_rng(seed).uniform`` over all n_d columns at once."""
+
+    amplitude: np.ndarray
+    seed: int
+
+    def draws(self, N: int) -> np.ndarray:
+        """(N + 1, n_d) draws, one row per sample."""
+        return self.amplitude * np.random.default_rng(self.seed).uniform(-1.0, 1.0, size=(N + 1, self.amplitude.size))
+
+
+def _random_disturbance(fields: Fields | None, plant: System, seed: int) -> RandomDisturbance | None:
+    """The ``[disturbance]`` table (module docstring); its seed defaults to one past the noise seed."""
+    if fields is None:
+        return None
+    amplitude = _point(fields, "uniform", plant.d, np.zeros(plant.d.size))
+    if np.any(amplitude < 0):
+        raise ScenarioError(f"{fields._name('uniform')}: amplitudes must be >= 0, got {amplitude.tolist()}")
+    disturbance = RandomDisturbance(amplitude, fields.integer("seed", seed + 1, unit="disturbance draws"))
+    fields.done()
+    return disturbance
 
 
 def _close(name: str, known) -> str:
@@ -246,7 +280,7 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
     return ResidualThreshold(name, residuals, std, step, targets=tuple(targets or ()), **options)
 
 
-DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector}
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "mmae": mmae_detector}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
@@ -282,6 +316,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     x0 = _point(initial, "x", plant.x, plant.x_op)
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
+    random_disturbance = _random_disturbance(top.table("disturbance"), plant, seed)
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number", "standard deviation of the output's sensor noise (its unit)", "none")
     noise = {}
@@ -327,7 +362,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
                           loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                           supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
-                          detectors=tuple(detectors), substitutions=by)
+                          detectors=tuple(detectors), substitutions=by, random_disturbance=random_disturbance)
 
 
 
@@ -341,7 +376,8 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     from uvsym.sim.system_simulation import run_wired
 
     N = round(scenario.duration / scenario.step)
-    W = loop_inputs(scenario.loop, N, scenario.d, scenario.seed)
+    d = scenario.d if scenario.random_disturbance is None else scenario.d + scenario.random_disturbance.draws(N)
+    W = loop_inputs(scenario.loop, N, d, scenario.seed)
     result = run_wired(scenario.loop, scenario.z0, W, method=method, supervisor=scenario.supervisor,
                        options=options, compiled=compiled, progress=progress, duration=scenario.duration,
                        seed=scenario.seed, actuator_faults=scenario.actuator_faults,
