@@ -200,3 +200,25 @@ def test_the_shipped_scenario_is_listed_by_the_cli(capsys):
     assert main(["simulate", "--list"]) == 0
     assert any(line.split()[:2] == ["otter_thruster_faults", "usv-fukf-mmae"]
                for line in capsys.readouterr().out.splitlines())
+
+
+def test_a_growing_fault_is_identified_again_where_its_estimate_settles():
+    alpha = [1.0, 0.8, 0.8, 0.8, 0.7, 0.6, 0.5, 0.4, 0.4, 0.4, 0.41, 0.4]
+    detector = HypothesisSwitch("d", "bank", MODEL_SET, settle=3, resolution=0.02)
+    events = [(e.t, e.event, e.value) for e in detector.decide(_series([0.95] * 12, [0.0] * 12, alpha))
+              if e.event == "identified"]
+    assert events == [(1.5, "identified", 0.8), (4.5, "identified", 0.4)]  # 0.41 is within 0.02 of 0.4
+
+
+def test_random_disturbances_are_bounded_by_their_amplitudes_and_seeded_apart_from_the_noise():
+    table = read()
+    table["disturbance"] = {"uniform": {"tau_u": 6.0, "tau_r": 3.0}}
+    table.update(seed=7)
+    disturbance = parsed(table).random_disturbance
+    assert disturbance.seed == 8  # default: one past the noise seed
+    draws = disturbance.draws(4000)
+    assert draws.shape == (4001, 3) and np.all(draws[:, 1] == 0.0)
+    assert np.all(np.abs(draws[:, 0]) <= 6.0) and np.max(np.abs(draws[:, 0])) > 5.9
+    assert np.all(np.abs(draws[:, 2]) <= 3.0) and abs(np.std(draws[:, 2]) - 3.0 / np.sqrt(3.0)) < 0.05
+    table["disturbance"]["seed"] = 9
+    assert not np.allclose(parsed(table).random_disturbance.draws(10), draws[:11])

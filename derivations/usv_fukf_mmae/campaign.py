@@ -1,6 +1,6 @@
 """The study's campaign (``campaign.toml`` beside this file, the same file ``uvsym campaign``
 runs): run by the report build; per detector and per case its figures from the event log, the
-false alarms per hour of the healthy runs by sensor noise, and the per-run table."""
+false alarms per hour by sensor noise, and the per-run table."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ __all__ = ["CAMPAIGN", "run_study_campaign", "campaign_section"]
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
 RATES = ("runs", "fault_runs", "detection_probability", "missed_detections", "median_detection_delay_s",
          "correct_isolation", "median_size_error_rel", "false_alarms", "healthy_hours", "false_alarms_per_hour")
+SIZE_TOLERANCE = 0.05  # |identified - true| of a delivered fraction that counts as badly sized
 ROW_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "noise.x", "status", "error")
 PER_DETECTOR = ("detected", "detection_delay_s", "isolated_target", "identified_value", "false_alarms")
 
@@ -25,6 +26,37 @@ def _noise(row: dict) -> str:
     """The run's sensor noise as a multiple of the paper's (x: 0.05 m), and whether the banks were told."""
     told = "banks told" in row["case"]
     return f"{(row.get('noise.x') or 0.05) / 0.05:g}x" + (", banks told" if told else "")
+
+
+def _problems(row: dict, detector: str) -> str | None:
+    """What a detector got wrong on a faulty run (missed, wrong thruster, not or badly sized), or None."""
+    if not row[f"{detector}:detected"]:
+        return "missed"
+    wrong = []
+    if row[f"{detector}:isolated_target"] != row["true_actuator"]:
+        wrong.append(f"isolated {row[f'{detector}:isolated_target'] or 'nothing'} at the end")
+    value = row[f"{detector}:identified_value"]
+    if value is None:
+        wrong.append("never sized (the estimate did not settle)")
+    elif row["true_kind"] == "proportional" and abs(value - row["true_value"]) > SIZE_TOLERANCE:
+        wrong.append(f"sized {value:.3g}")
+    return "; ".join(wrong) or None
+
+
+def _failures(rows: list[dict], detectors: list[str]) -> list[dict]:
+    """Per faulty run with a problem: the run and, per problem, the detectors that had it."""
+    found = []
+    for row in rows:
+        if row["status"] != "ok" or not row["n_faults"]:
+            continue
+        problems: dict[str, list[str]] = {}
+        for d in detectors:
+            if (problem := _problems(row, d)) is not None:
+                problems.setdefault(problem, []).append(d)
+        found += [{"case": row["case"], "thruster": row["true_actuator"], "kind": row["true_kind"],
+                   "value": row["true_value"], "noise": _noise(row), "problem": problem, "detectors": names}
+                  for problem, names in problems.items()]
+    return found
 
 
 def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict:
@@ -36,17 +68,17 @@ def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict
         rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
     detectors = detector_names(rows)
     cases = list(dict.fromkeys(r["case"] for r in rows))
-    healthy = [r for r in rows if not r["n_faults"]]
     figures = {
         "runs": len(rows), "errors": sum(r["status"] != "ok" for r in rows),
         "simulated_s": sum(r.get("duration_s") or 0.0 for r in rows),
         "detectors": {d: {k: detector_rates(rows, d)[k] for k in RATES} for d in detectors},
         "cases": {c: {d: {k: detector_rates([r for r in rows if r["case"] == c], d)[k] for k in RATES}
                       for d in detectors} for c in cases},
-        "healthy_by_noise": {n: {d: {k: detector_rates([r for r in healthy if _noise(r) == n], d)[k]
+        "healthy_by_noise": {n: {d: {k: detector_rates([r for r in rows if _noise(r) == n], d)[k]
                                      for k in ("runs", "false_alarms", "healthy_hours", "false_alarms_per_hour")}
-                                 for d in detectors} for n in dict.fromkeys(_noise(r) for r in healthy)},
+                                 for d in detectors} for n in dict.fromkeys(_noise(r) for r in rows)},
     }
+    figures["failures"] = _failures(rows, detectors)
     columns = list(ROW_COLUMNS) + [f"{d}:{c}" for d in detectors for c in PER_DETECTOR]
     with (out_dir / "campaign_results.csv").open("w", newline="") as handle:
         writer = csv.writer(handle)
@@ -71,6 +103,8 @@ def campaign_section(c: dict) -> str:
     healthy = [[noise] + [f"{per[d]['false_alarms']} in {_f(per[d]['healthy_hours'])} h: "
                           f"{_f(per[d]['false_alarms_per_hour'])} /h" for d in detectors]
                for noise, per in c["healthy_by_noise"].items()]
+    failures = [[f["case"], f"{f['thruster']} {f['kind']} {f['value']:g}", f["noise"], f["problem"],
+                 ", ".join(f["detectors"])] for f in c["failures"]]
     return f"""## Campaign: what a user meets
 
 [campaign.toml](../../derivations/usv_fukf_mmae/campaign.toml) ({c["runs"]} runs, {c["simulated_s"] / 60:.0f} min
@@ -92,9 +126,15 @@ Per case (detection probability / median delay s / correct isolation / false ala
 
 {markdown_table(["case"] + detectors, cases)}
 
-Healthy runs by sensor noise (a multiple of the paper's; the banks keep the paper's R unless told):
+False alarms by sensor noise (a multiple of the paper's; the banks keep the paper's R unless told),
+over the healthy runs and the stretches before each onset:
 
 {markdown_table(["noise"] + detectors, healthy)}
+
+Where the banks fail (faulty runs on which a detector missed, ended on the wrong thruster, or sized
+the loss more than {SIZE_TOLERANCE:g} off; computed from the runs above):
+
+{markdown_table(["case", "fault", "noise", "what went wrong", "detectors"], failures) if failures else "none."}
 
 Every run's row is in [campaign_results.csv](campaign_results.csv).
 """

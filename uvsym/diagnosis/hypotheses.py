@@ -9,10 +9,11 @@ before ``ignore_before`` s lead nowhere). On a switch away from a fault hypothes
 on each of its inputs; onto one: ``detected`` (on its input, or none for a hypothesis of several
 inputs), then per input ``isolated``, of ``kind`` (default ``proportional``: the size is the
 fraction of the command delivered, as the efficiency is). The estimate
-``<model>.alpha_<input>_hat`` converges after the switch: ``identified`` (of ``kind``, with the
-estimate as value) follows once per switch, at the first sample from the switch on at which the
-estimate has stayed within ``resolution`` over the last ``settle`` samples, if the hypothesis
-still stands then.
+``<model>.alpha_<input>_hat`` converges after the switch: while the hypothesis stands,
+``identified`` (of ``kind``, with the estimate as value) follows at each sample at which the
+estimate has stayed within ``resolution`` over the last ``settle`` samples (it has settled) and
+lies more than ``resolution`` from the last value identified since the switch (the first time:
+from none), so a fault that keeps growing is identified again where it settles.
 
 The threshold is a posterior probability: the bank's likelihoods already carry its noise model
 (R and Q), so it is not calibrated again from a false-alarm rate; the rate it gives is measured
@@ -70,7 +71,7 @@ class HypothesisSwitch:
         spread = {(m, u): self._spread(read_signal(result, f"{self.bank}.{m}.alpha_{u}_hat"))
                   for m, inputs in self.models for u in inputs}
         current = next(i for i, (_, inputs) in enumerate(self.models) if not inputs)
-        events, candidate, run, pending = [], -1, 0, ()
+        events, candidate, run, identified = [], -1, 0, {}
         for k, lead in enumerate(leading):
             candidate, run = (candidate, run + 1) if lead == candidate else (int(lead), 1)
             time = round(float(t[k]), 9)
@@ -82,12 +83,13 @@ class HypothesisSwitch:
                     events.append(Event(time, "detected", inputs[0] if len(inputs) == 1 else None,
                                         detector=self.name))
                 events += [Event(time, "isolated", u, self.kind, detector=self.name) for u in inputs]
-                pending = inputs
-            model = self.models[current][0]
-            for u in [u for u in pending if spread[model, u][0][k] <= self.resolution]:
-                events.append(Event(time, "identified", u, self.kind, float(spread[model, u][1][k]),
-                                    detector=self.name))
-                pending = tuple(v for v in pending if v != u)
+                identified = {}
+            model, inputs = self.models[current]
+            for u in inputs:
+                width, value = spread[model, u][0][k], float(spread[model, u][1][k])
+                if width <= self.resolution and abs(value - identified.get(u, np.inf)) > self.resolution:
+                    identified[u] = value
+                    events.append(Event(time, "identified", u, self.kind, value, detector=self.name))
         return events
 
     def _spread(self, estimate: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -27,7 +27,7 @@ every block reading channel reads the substitute, from the next sample) and ``[[
 - ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions;
 - ``type = "mmae"``: ``bank`` (an mmae block's name), ``threshold`` (probability, default 0.9),
   ``dwell`` (samples, default 1), ``settle`` (samples, default 20) and ``resolution`` (default
-  0.02: the efficiency estimate is published once it stays within it over settle samples),
+  0.02: an efficiency estimate is published where it stays within it over settle samples),
   ``ignore_before`` (s), ``kind`` (default proportional): the
   bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`).
 
