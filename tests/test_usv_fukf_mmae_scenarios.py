@@ -222,3 +222,21 @@ def test_random_disturbances_are_bounded_by_their_amplitudes_and_seeded_apart_fr
     assert np.all(np.abs(draws[:, 2]) <= 3.0) and abs(np.std(draws[:, 2]) - 3.0 / np.sqrt(3.0)) < 0.05
     table["disturbance"]["seed"] = 9
     assert not np.allclose(parsed(table).random_disturbance.draws(10), draws[:11])
+
+
+def test_the_campaign_covers_both_thrusters_profiles_noise_levels_and_healthy_hours():
+    from derivations.usv_fukf_mmae.campaign import CAMPAIGN
+    from uvsym.campaign import load_campaign
+
+    runs = load_campaign(CAMPAIGN).runs  # every run's scenario validated here
+    faults = [f for r in runs for f in r.scenario["faults"]]
+    assert {f["actuator"] for f in faults} == {"T_L", "T_R"}
+    assert {f.get("profile", "step") for f in faults} == {"step", "ramp", "intermittent"}
+    assert {f["kind"] for f in faults} == {"proportional", "constant"}
+    losses = [f["value"] for f in faults if f["kind"] == "proportional"]
+    assert min(losses) <= 0.2 and max(losses) >= 0.95
+    noise = {r.scenario["noise"]["x"] for r in runs}
+    assert noise == {0.05, 0.1, 0.15}
+    healthy = sum(r.scenario["duration"] for r in runs if not r.scenario["faults"] and r.scenario["noise"]["x"] == 0.05)
+    assert healthy >= 1440.0  # s of healthy runs at the paper's noise (24 min; onsets add more)
+    assert all(len(r.scenario["detectors"]) == 4 for r in runs)
