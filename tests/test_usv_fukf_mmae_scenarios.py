@@ -240,3 +240,15 @@ def test_the_campaign_covers_both_thrusters_profiles_noise_levels_and_healthy_ho
     healthy = sum(r.scenario["duration"] for r in runs if not r.scenario["faults"] and r.scenario["noise"]["x"] == 0.05)
     assert healthy >= 1440.0  # s of healthy runs at the paper's noise (24 min; onsets add more)
     assert all(len(r.scenario["detectors"]) == 4 for r in runs)
+
+
+def test_the_autopilot_clamps_its_commands_to_the_limits_it_is_given():
+    table = read()
+    table.update(duration=5.0, faults=[], detectors=[])
+    table["blocks"] = [dict(block_table(table, "guidance"), limits=[-10.0, 20.0])]
+    commands = experiment.run(parsed(table))["guidance"]
+    both = np.column_stack([commands["T_L"], commands["T_R"]])
+    assert both.max() == pytest.approx(20.0) and both.min() >= -10.0
+    table["blocks"][0]["limits"] = [20.0, -10.0]
+    with pytest.raises(ScenarioError, match=r"^blocks\[0\]\.limits: expected \[lo, hi\] with lo < hi"):
+        parsed(table)

@@ -7,8 +7,9 @@ Fields (besides type and name): ``waypoints`` ([north, east] pairs, m), ``lookah
 ``heading_loop`` (tables ``kp``, ``ki``, ``kd``, ``feedforward``, ``i_limit``: the loops of
 :class:`~uvsym.sim.controllers.Loop`, in N per m/s and N m per rad for thrust commands),
 ``mix`` (``{speed = {input = coefficient}, yaw = {...}}``), ``reads`` (the measured north, east,
-heading, surge, sway and yaw rate: six loop signal names, default the plant's six states) and
-``saturate`` (clamp to the plant's input limits, default true).
+heading, surge, sway and yaw rate: six loop signal names, default the plant's six states),
+``limits`` ([lo, hi] for every input, in the inputs' unit; default the plant's input limits) and
+``saturate`` (clamp to the limits, default true).
 
 State: the two loops' error integrals, an unused depth integral and the LOS segment index;
 publishes the mixed inputs, ``psi_ref`` (rad) and ``cross_track`` (m).
@@ -93,7 +94,11 @@ def autopilot_block(fields: Fields, plant: System, dt: float, name: str) -> Bloc
     if not isinstance(saturate, bool):
         raise ScenarioError(f"{fields._name('saturate')}: expected true or false, got {saturate!r}")
     model = _Mixing(plant.u.names)
-    low, high = ca.DM(np.asarray(plant.u_min, float)), ca.DM(np.asarray(plant.u_max, float))
+    limits = fields.vector("limits", 2)
+    if limits is not None and not limits[0] < limits[1]:
+        raise ScenarioError(f"{fields._name('limits')}: expected [lo, hi] with lo < hi, got {limits.tolist()}")
+    low, high = ((ca.DM(np.asarray(plant.u_min, float)), ca.DM(np.asarray(plant.u_max, float))) if limits is None
+                 else (ca.DM.ones(plant.u.size) * limits[0], ca.DM.ones(plant.u.size) * limits[1]))
     state = Signals(autopilot.state_labels, ("m s", "rad s", "m s", "-"), group="state")
     publishes = plant.u.renamed(group="published") + Signals(("psi_ref", "cross_track"), ("rad", "m"),
                                                              ("heading set-point", "cross-track error"), "published")

@@ -20,7 +20,7 @@ ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
 lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
                  hold, confirm (samples)
 autopilot        waypoints, lookahead, turn_radius, acceptance, speed, speed_loop, heading_loop,
-                 mix, reads, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
+                 mix, reads, limits, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
 mmae             filter (ukf, ekf), models (hypothesis = inputs with an efficiency state), q, r,
                  p0, x0, efficiency_p0, walk_std, floor, prior, reset, steps, alpha, beta, kappa
                  (:mod:`uvsym.observers.mmae_design`)
