@@ -33,12 +33,15 @@ from c_timing import c_loop_ns  # noqa: E402
 from common import finish  # noqa: E402
 
 import uvsym  # noqa: E402
-from derivations.usv_fukf_mmae.experiment import MODELS, TUNING, bank, filters, simulate_plant  # noqa: E402
-from derivations.usv_fukf_mmae.scenario import SHIPPED, load  # noqa: E402
+from derivations.usv_fukf_mmae.experiment import disturbed_plant, run  # noqa: E402
+from derivations.usv_fukf_mmae.observer_sets import shipped_bank  # noqa: E402
+from derivations.usv_fukf_mmae.scenario import block_table, parsed, read  # noqa: E402
 from uvsym.codegen import find_compiler  # noqa: E402
 from uvsym.codegen.estimators import exported_observer  # noqa: E402
 from uvsym.codegen.observer_sets import ObserverSet  # noqa: E402
 from uvsym.observers.kalman import filter_observer, run_filter, transition  # noqa: E402
+from uvsym.observers.mmae_design import bank_filters  # noqa: E402
+from uvsym.sim.fields import Fields  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results" / "ukf.json"
 SAMPLES = 1000  # samples filterpy runs (it is slow); uvsym's C is timed per call
@@ -78,23 +81,28 @@ def numpy_model():
     return fx
 
 
-def filterpy_filters(scenario, fx) -> dict:
-    """model -> filterpy UKF with the derivation's tuning."""
+def shipped_filters(tuning: dict, dt: float) -> dict:
+    """model -> the shipped UKF bank's filter (``tuning``: the scenario's ukf block)."""
+    return bank_filters(Fields(tuning, "ukf"), disturbed_plant(), dt)
+
+
+def filterpy_filters(tuning: dict, dt: float, fx) -> dict:
+    """model -> filterpy UKF with the shipped UKF bank's tuning."""
     built = {}
-    for name, filt in filters(scenario, "ukf").items():
+    for name, filt in shipped_filters(tuning, dt).items():
         n = filt.x0.size
-        which = None if not MODELS[name] else ("T_L", "T_R").index(MODELS[name][0])
-        points = MerweScaledSigmaPoints(n, alpha=TUNING["ukf"]["alpha"], beta=TUNING["ukf"]["beta"],
-                                        kappa=TUNING["ukf"]["kappa"])
-        ukf = UnscentedKalmanFilter(n, 6, scenario.dt, hx=lambda x: x[:6], fx=fx, points=points)
+        inputs = tuning["models"][name]
+        which = None if not inputs else ("T_L", "T_R").index(inputs[0])
+        points = MerweScaledSigmaPoints(n, alpha=tuning["alpha"], beta=tuning["beta"], kappa=tuning["kappa"])
+        ukf = UnscentedKalmanFilter(n, 6, dt, hx=lambda x: x[:6], fx=fx, points=points)
         ukf.x, ukf.P, ukf.Q, ukf.R = filt.x0.copy(), filt.P0.copy(), filt.Q.copy(), filt.R.copy()
         built[name] = (ukf, which)
     return built
 
 
-def filterpy_ukf_us(scenario, fx, Y, U) -> float:
+def filterpy_ukf_us(tuning: dict, dt: float, fx, Y, U) -> float:
     """filterpy's left-model UKF, update then predict per sample: microseconds per sample."""
-    ukf, which = filterpy_filters(scenario, fx)["left"]
+    ukf, which = filterpy_filters(tuning, dt, fx)["left"]
     started = time.process_time()
     for y, u in zip(Y, U):
         ukf.update(y)
@@ -102,22 +110,22 @@ def filterpy_ukf_us(scenario, fx, Y, U) -> float:
     return (time.process_time() - started) / len(Y) * 1e6
 
 
-def filterpy_bank_us(scenario, fx, Y, U) -> tuple[float, np.ndarray]:
+def filterpy_bank_us(tuning: dict, dt: float, fx, Y, U) -> tuple[float, np.ndarray]:
     """Three filterpy UKFs in the MMAE loop (log-space Bayes with the floor, fusion, reset): us per sample."""
-    bank_filters = filterpy_filters(scenario, fx)
-    logp = np.log(np.asarray(TUNING["prior"]))
-    floor = np.log(TUNING["p_min"])
+    bank = filterpy_filters(tuning, dt, fx)
+    logp = np.log(np.asarray(tuning["prior"]))
+    floor = np.log(tuning["floor"])
     probabilities = []
     started = time.process_time()
     for y, u in zip(Y, U):
-        for ukf, _ in bank_filters.values():
+        for ukf, _ in bank.values():
             ukf.update(y)
-        logp = logp + np.array([ukf.log_likelihood for ukf, _ in bank_filters.values()])
+        logp = logp + np.array([ukf.log_likelihood for ukf, _ in bank.values()])
         logp = np.maximum(logp - logsumexp(logp), floor)
         logp -= logsumexp(logp)
         p = np.exp(logp)
-        fused = sum(pi * ukf.x[:6] for pi, (ukf, _) in zip(p, bank_filters.values()))
-        for ukf, which in bank_filters.values():
+        fused = sum(pi * ukf.x[:6] for pi, (ukf, _) in zip(p, bank.values()))
+        for ukf, which in bank.values():
             ukf.x[:6] = fused
             ukf.predict(u=u, which=which)
         probabilities.append(p)
@@ -133,10 +141,10 @@ def c_step_ns(observer, y, u) -> dict:
         folder = Path(scratch)
         ObserverSet(name, observer.description, (exported_observer(observer),)).write(folder)
         s0 = observer.initial_state(y, u)
-        n_s, n_out = observer.state.size, observer.publishes.size
+        n_s, n_out, n_p = observer.state.size, observer.publishes.size, max(1, observer.params.size)
         values = ", ".join(f"{v:.17g}" for v in s0)
         setup = f"""
-  static {name}_real s[{n_s}] = {{{values}}}, s_next[{n_s}], out[{n_out}], p[1] = {{0}};  /* no parameters */
+  static {name}_real s[{n_s}] = {{{values}}}, s_next[{n_s}], out[{n_out}], p[{n_p}] = {{0}};  /* still water */
   static {name}_real y[6] = {{{", ".join(f"{v:.17g}" for v in y)}}}, u[2] = {{{u[0]:.17g}, {u[1]:.17g}}};"""
         wall_template = c_timing.TEMPLATE
         timings = {}
@@ -154,20 +162,21 @@ def c_step_ns(observer, y, u) -> dict:
 
 
 def main() -> dict:
-    scenario = load(SHIPPED["otter_thruster_faults"], "otter_thruster_faults")
-    result = simulate_plant(scenario)
-    Y, U = result["y"].values, result["guidance"].values
+    table = read()
+    tuning, dt = block_table(table, "ukf"), table["step"]
+    result = run(parsed(table))
+    Y, U = result["y"].values, result["guidance"].values[:, :2]  # T_L, T_R
     fx = numpy_model()
-    left = filter_observer(filters(scenario, "ukf")["left"], "left-thruster UKF")
-    ukf_bank = bank(scenario, "ukf")
+    left = filter_observer(shipped_filters(tuning, dt)["left"], "left-thruster UKF")
+    ukf_bank = shipped_bank("ukf")
     ukf_ns = c_step_ns(left, Y[0], U[0])
     bank_ns = c_step_ns(ukf_bank, Y[0], U[0])
     started = time.process_time()
     _, OUT = run_filter(ukf_bank, Y[:SAMPLES], U[:SAMPLES])
     vm_us = (time.process_time() - started) / SAMPLES * 1e6
-    fp_ukf_us = filterpy_ukf_us(scenario, fx, Y[:SAMPLES], U[:SAMPLES])
-    fp_bank_us, fp_p = filterpy_bank_us(scenario, fx, Y[:SAMPLES], U[:SAMPLES])
-    uvsym_p = OUT[:, [ukf_bank.publishes.index(f"p_{m}") for m in MODELS]]
+    fp_ukf_us = filterpy_ukf_us(tuning, dt, fx, Y[:SAMPLES], U[:SAMPLES])
+    fp_bank_us, fp_p = filterpy_bank_us(tuning, dt, fx, Y[:SAMPLES], U[:SAMPLES])
+    uvsym_p = OUT[:, [ukf_bank.publishes.index(f"p_{m}") for m in tuning["models"]]]
     return {"ukf_step_ns": ukf_ns["cpu"], "bank_step_ns": bank_ns["cpu"],
             "speedup_vs_filterpy_ukf": fp_ukf_us * 1e3 / ukf_ns["cpu"],
             "speedup_vs_filterpy_mmae": fp_bank_us * 1e3 / bank_ns["cpu"],

@@ -1,8 +1,6 @@
-"""The FUKF-MMAE derivation: its scenario's validation, a shortened run through ``simulate``, the
-figures of merit on hand-made series, the paper's eq. 4 checked against eqs. 1-3 by hand."""
-
-import dataclasses
-import tomllib
+"""The FUKF-MMAE derivation: its shipped scenario, a shortened run with both banks in the loop,
+the figures of merit on hand-made series, the paper's eq. 4 checked against eqs. 1-3 by hand,
+the no-fault UKF's consistency (NEES) on healthy runs."""
 
 import numpy as np
 import pytest
@@ -12,65 +10,44 @@ import uvsym
 from derivations.usv_fukf_mmae import analysis, experiment
 from derivations.usv_fukf_mmae.observer_sets import usv_fukf_mmae
 from derivations.usv_fukf_mmae.paper import eq4_check, eq11_check
-from derivations.usv_fukf_mmae.scenario import SHIPPED, parse
+from derivations.usv_fukf_mmae.scenario import ThrusterFault, block_table, parsed, read, thruster_faults
 from uvsym.derivation import derivation, study_scenarios
-from uvsym.errors import ScenarioError, UnknownNameError
+from uvsym.errors import UnknownNameError
 from uvsym.observers.kalman import filter_observer, run_filter, unpacked
+from uvsym.observers.mmae_design import bank_filters
+from uvsym.sim.fields import Fields
 
 
-def shipped() -> dict:
-    table = tomllib.loads(SHIPPED["otter_thruster_faults"].read_text())
-    assert table.pop("study") == "usv-fukf-mmae"
-    return table
-
-
-def test_registered_with_its_scenario():
+def test_registered_with_its_scenario_file():
     study = derivation("usv-fukf-mmae")
-    assert study.simulate is not None and study_scenarios()["otter_thruster_faults"][0] == "usv-fukf-mmae"
-    sc = parse(shipped(), "x")
-    assert (sc.dt, sc.duration) == (0.05, 300.0)
-    assert [(f.thruster, f.efficiency, f.onset, f.end) for f in sc.faults] == [("T_L", 0.4, 100.0, 150.0),
-                                                                            ("T_R", 0.3, 200.0, 250.0)]
+    assert study.simulate is None and study_scenarios()["otter_thruster_faults"][0] == "usv-fukf-mmae"
+    sc = parsed(read())
+    assert (sc.step, sc.duration) == (0.05, 300.0)
+    assert thruster_faults(sc) == (ThrusterFault("T_L", 0.4, 100.0, 150.0), ThrusterFault("T_R", 0.3, 200.0, 250.0))
+    assert [d.name for d in sc.detectors] == ["ukf_mmae", "ekf_mmae"]
 
 
-@pytest.mark.parametrize("edit, field", [
-    (lambda t: t["faults"][0].update(thruster="T_X"), "faults[0].thruster"),
-    (lambda t: t["faults"][1].update(efficiency=1.0), "faults[1].efficiency"),
-    (lambda t: t["faults"][0].update(end=90.0), "faults[0].end"),
-    (lambda t: t["faults"][0].update(end=400.0), "faults[0].end"),
-    (lambda t: t["faults"][0].update(severity=0.6), "faults[0].severity"),
-    (lambda t: t.update(dt=0.0), "dt"),
-    (lambda t: t.update(vehicle="remus100"), "vehicle"),
-    (lambda t: t.update(wind=3), "wind"),
-    (lambda t: t["noise"].pop("psi"), "noise.psi"),
-    (lambda t: t["disturbance"].update(alpha_d=[1.0, 2.0]), "disturbance.alpha_d"),
-    (lambda t: t["path"].update(waypoints=[[0.0, 0.0]]), "path.waypoints"),
-    (lambda t: t["path"].update(speed=-1.0), "path.speed"),
-    (lambda t: t.update(seed=-2), "seed"),
-])
-def test_bad_scenario_fields_are_named(edit, field):
-    table = shipped()
-    edit(table)
-    with pytest.raises(ScenarioError, match=rf"^{__import__('re').escape(field)}\b"):
-        parse(table, "bad")
-
-
-def test_a_shortened_run_detects_and_estimates_the_fault():
-    """40 s with the left thruster at 50 % on [10, 25) s, through the derivation's simulate."""
-    table = shipped()
-    table.update(duration=40.0, faults=[{"thruster": "T_L", "efficiency": 0.5, "onset": 10.0, "end": 25.0}])
-    result = derivation("usv-fukf-mmae").simulate(table, name="short")
-    scenario = parse(table, "short")
-    np.testing.assert_allclose(result["u"]["T_L"][(result.t >= 11) & (result.t < 24)],
-                               0.5 * result["guidance"]["T_L"][(result.t >= 11) & (result.t < 24)])
-    for method in ("ukf", "ekf"):
-        figures = analysis.bank_figures(result.t, result[f"{method}_bank"], scenario)
+def test_a_shortened_run_detects_isolates_and_sizes_the_fault():
+    """40 s with the left thruster at 50 % on [10, 25) s, both banks in the loop."""
+    table = read()
+    table.update(duration=40.0, faults=[{"actuator": "T_L", "kind": "proportional", "value": 0.5, "onset": 10.0,
+                                         "end": 25.0}])
+    scenario = parsed(table)
+    result = experiment.run(scenario)
+    window = (result.t >= 11) & (result.t < 24)
+    np.testing.assert_allclose(result["u"]["T_L"][window], 0.5 * result["guidance"]["T_L"][window])
+    for method in analysis.BANKS:
+        figures = analysis.bank_figures(result.t, result[method], thruster_faults(scenario))
         fault = figures["faults"][0]
         assert fault["detect_delay_s"] is not None and fault["detect_delay_s"] <= 5.0
         assert abs(fault["efficiency_estimate"] - 0.5) < 0.05
         assert figures["p_nofault_min_outside_windows"] > 0.9
-        fused = result[f"{method}_bank"]
-        assert np.sqrt(np.mean((fused["psi_hat"] - result["x"]["psi"]) ** 2)) < 0.01
+        assert np.sqrt(np.mean((result[method]["psi_hat"] - result["x"]["psi"]) ** 2)) < 0.01
+        own = [e for e in result.events if e["detector"] == f"{method}_mmae"]
+        assert [(e["event"], e["target"]) for e in own] == [("detected", "T_L"), ("isolated", "T_L"),
+                                                             ("identified", "T_L"), ("cleared", "T_L")]
+        assert own[0]["t"] == pytest.approx(10.0 + fault["detect_delay_s"])
+        assert abs(own[2]["value"] - 0.5) < 0.05 and 25.0 <= own[3]["t"] <= 26.0
 
 
 def test_detection_delay_and_outside_windows_on_hand_made_series():
@@ -78,9 +55,9 @@ def test_detection_delay_and_outside_windows_on_hand_made_series():
     p = np.where((t >= 7.5) & (t < 12.0), 0.95, 0.02)
     assert analysis._detect_delay(t, p, 6.0, 12.0) == 1.5
     assert analysis._detect_delay(t, p, 13.0, 18.0) is None
-    sc = parse(shipped(), "x")
+    faults = thruster_faults(parsed(read()))
     t = np.array([1.0, 5.0, 99.0, 100.0, 152.0, 155.0, 199.9, 249.0, 255.0, 299.0])
-    assert analysis._outside(t, sc).tolist() == [False, True, True, False, False, True, True, False, True, True]
+    assert analysis._outside(t, faults).tolist() == [False, True, True, False, False, True, True, False, True, True]
 
 
 def test_printed_eq4_differs_from_eqs_1_to_3_in_the_sway_and_yaw_rows():
@@ -108,17 +85,21 @@ def test_unknown_codegen_method_is_refused():
 
 
 def test_nees_of_the_no_fault_ukf_on_healthy_runs_is_within_its_chi_square_bounds():
-    """Monte Carlo over 12 healthy runs (no fault, 15 s, other seeds) of the derivation's scenario:
-    the no-fault UKF's NEES averaged over runs lies in its 99 % chi-square band at >= 90 % of the
+    """Monte Carlo over 12 healthy runs (no fault, 15 s, other seeds) of the shipped scenario: the
+    no-fault UKF's NEES averaged over runs lies in its 99 % chi-square band at >= 90 % of the
     samples after the first second. Q comes from the disturbance (``process_noise``), so this
     checks that the tuning is consistent, neither optimistic nor conservative."""
-    base, runs = parse(shipped(), "healthy"), 12
-    nees = []
+    runs, nees = 12, []
+    table = read()
+    filt = bank_filters(Fields(block_table(table, "ukf"), "ukf"), experiment.disturbed_plant(), 0.05)["nofault"]
     for seed in range(runs):
-        scenario = dataclasses.replace(base, seed=50 + seed, duration=15.0, faults=())
-        result = experiment.simulate_plant(scenario)
-        filt = experiment.filters(scenario, "ukf")["nofault"]
-        S, OUT = run_filter(filter_observer(filt, "healthy"), result["y"].values, result["guidance"].values)
+        table = read()
+        table.update(seed=50 + seed, duration=15.0, faults=[], detectors=[])
+        table["disturbance"]["seed"] = 150 + seed
+        table["blocks"] = [block_table(table, "guidance")]
+        result = experiment.run(parsed(table))
+        commands = result["guidance"].values[:, [result["guidance"].labels.index(n) for n in ("T_L", "T_R")]]
+        S, OUT = run_filter(filter_observer(filt, "healthy"), result["y"].values, commands)
         errors = result["x"].values - OUT[:, :6]
         priors = [unpacked(s[6:], 6) for s in S[:-1]]
         posteriors = [P - P @ np.linalg.solve(P + filt.R, P) for P in priors]  # y = x: the exact update

@@ -1,4 +1,4 @@
-"""``report.md``, ``results.json`` and Figs. 3-7 of the FUKF-MMAE reproduction."""
+"""``report.md``, ``results.json`` and Figs. 3-7 of the FUKF-MMAE reproduction, and its campaign."""
 
 from __future__ import annotations
 
@@ -7,17 +7,17 @@ from pathlib import Path
 import numpy as np
 
 from derivations.usv_fukf_mmae import analysis as A
-from derivations.usv_fukf_mmae.experiment import GAINS, MODELS, TUNING, bank_signal, run_scenario
+from derivations.usv_fukf_mmae.campaign import campaign_section, run_study_campaign
+from derivations.usv_fukf_mmae.experiment import run
 from derivations.usv_fukf_mmae.figures import FIGURES, draw_all
 from derivations.usv_fukf_mmae.observer_sets import usv_fukf_mmae
 from derivations.usv_fukf_mmae.paper import CITATION, eq4_check, eq11_check, eq18_check
-from derivations.usv_fukf_mmae.scenario import SHIPPED, load
+from derivations.usv_fukf_mmae.scenario import SCENARIO, block_table, parsed, read, thruster_faults
 from uvsym.report import markdown_table, write_json
 from uvsym.report.sections import c_package, c_section
 
 __all__ = ["build", "TARGETS"]
 
-SCENARIO = "otter_thruster_faults"
 RESOLUTION = 1e-3  # s or efficiency: differences below this are called equal
 FLOOR_CHECK = 1e-3  # the reproduction notes' proposed floor, run beside the chosen one
 TARGETS = {"p_nofault_min_outside_windows": ("> 0.9", lambda v: v is not None and v > A.THRESHOLD),
@@ -29,9 +29,9 @@ def _efficiency_target(true: float):
             lambda v: v is not None and abs(v - true) <= A.EFFICIENCY_TOLERANCE)
 
 
-def _target_rows(results: dict, scenario) -> list[dict]:
+def _target_rows(results: dict, faults) -> list[dict]:
     """Every target key of results.json with its value, target and whether it is met."""
-    severity = {A.SIDE[f.thruster]: f.efficiency for f in reversed(scenario.faults)}
+    severity = {A.SIDE[f.thruster]: f.efficiency for f in reversed(faults)}
     rows = []
     for prefix in ("", "ekf_"):
         for key in sorted(k for k in results if k.startswith(prefix) and (prefix or not k.startswith("ekf_"))):
@@ -44,35 +44,49 @@ def _target_rows(results: dict, scenario) -> list[dict]:
     return rows
 
 
-def _fmt(v, digits: int = 4) -> str:
-    return "not reached" if v is None else f"{v:.{digits}g}"
+def _floor_check(table: dict, faults) -> dict:
+    """The UKF bank alone with the probability floor FLOOR_CHECK, its figures of merit."""
+    block_table(table, "ukf")["floor"] = FLOOR_CHECK
+    table["blocks"] = [b for b in table["blocks"] if b["name"] != "ekf"]
+    table["detectors"] = [d for d in table["detectors"] if d["bank"] != "ekf"]
+    result = run(parsed(table))
+    return A.bank_figures(result.t, result["ukf"], faults)
 
 
 def build(out_dir: Path, progress) -> None:
-    """Simulate, run both banks, export the UKF bank as C, write the report into ``out_dir``."""
-    scenario = load(SHIPPED[SCENARIO], SCENARIO)
-    progress("closed loop (LOS guidance, thruster faults) and both banks, 300 s")
-    result = run_scenario(scenario, progress=None)
-    merit = A.figures_of_merit(result, scenario)
+    """Simulate with both banks in the loop, export the UKF bank as C, run the campaign, write the report."""
+    table = read()
+    scenario = parsed(table)
+    faults = thruster_faults(scenario)
+    progress(f"closed loop (LOS guidance, thruster faults, both banks), {scenario.duration:g} s")
+    result = run(scenario)
+    merit = A.figures_of_merit(result, faults)
     progress("figures")
-    draw_all(result, scenario, out_dir)
+    draw_all(result, faults, block_table(table, "guidance")["waypoints"], out_dir)
     progress(f"sensitivity: the UKF bank with the floor {FLOOR_CHECK:g}")
-    floor_check = A.bank_figures(result.t, bank_signal(scenario, result, "ukf", FLOOR_CHECK), scenario)
+    floor_check = _floor_check(read(), faults)
     progress("C package of the UKF bank: write, compile, compare")
     c = c_package(usv_fukf_mmae("ukf"), out_dir / "c")
+    progress("campaign")
+    campaign = run_study_campaign(out_dir, progress)
     n = 6 + 1
+    unscented = {key: block_table(table, "ukf")[key] for key in ("alpha", "beta", "kappa")}
     results = {key: value for key, value in merit.items() if key not in ("banks", "rms_error_outside_windows")}
-    rows = _target_rows(results, scenario)
-    ukf, ekf = result["ukf_bank"], result["ekf_bank"]
+    rows = _target_rows(results, faults)
+    ukf, ekf = result["ukf"], result["ekf"]
     results.update({"ukf_minus_ekf_max_abs": {name: float(np.max(np.abs(ukf[name] - ekf[name])))
                                               for name in ukf.labels if name.endswith("_hat") or name.startswith("p_")},
                     "targets": rows, "banks": merit["banks"], "ukf_bank_with_floor_1e-3": floor_check,
-                    "rms_error_outside_windows": merit["rms_error_outside_windows"], "tuning": TUNING,
-                    "controller_gains": GAINS,
-                    "paper_checks": {"eq4": eq4_check(), "eq11": eq11_check(n, **TUNING["ukf"]),
-                                     "eq18": eq18_check(n, 6)}, "c": c})
+                    "rms_error_outside_windows": merit["rms_error_outside_windows"], "events": result.events,
+                    "detectors": result.meta["detectors"],
+                    "paper_checks": {"eq4": eq4_check(), "eq11": eq11_check(n, **unscented),
+                                     "eq18": eq18_check(n, 6)}, "c": c, "campaign": campaign})
     write_json(out_dir / "results.json", results)
-    (out_dir / "report.md").write_text(_report(results, scenario))
+    (out_dir / "report.md").write_text(_report(results, table, faults))
+
+
+def _fmt(v, digits: int = 4) -> str:
+    return "not reached" if v is None else f"{v:.{digits}g}"
 
 
 def _comparison(banks: dict) -> list[list[str]]:
@@ -113,43 +127,54 @@ def _claims(banks: dict) -> list[list[str]]:
              f"UKF vs EKF |alpha_hat - alpha|: {errors}"]]
 
 
-def _report(r: dict, scenario) -> str:
+def _report(r: dict, table: dict, faults) -> str:
     eq4, eq11 = r["paper_checks"]["eq4"], r["paper_checks"]["eq11"]
     eq4_rows = [[row, f"{p:.6g}", f"{d:.6g}", f"{p - d:.3g}"] for row, p, d in
                 zip(eq4["rows"], eq4["printed"], eq4["derived"])]
     targets = [[t["key"], _fmt(t["value"]), t["target"], "met" if t["met"] else "**missed**"] for t in r["targets"]]
-    rms = [[s] + [f"{r['rms_error_outside_windows'][m][s]:.3g}" for m in ("ukf", "ekf")]
+    rms = [[s] + [f"{r['rms_error_outside_windows'][m][s]:.3g}" for m in A.BANKS]
            for s in r["rms_error_outside_windows"]["ukf"]]
-    faults = [[f.thruster, f"{f.efficiency:g}", f"{(1 - f.efficiency) * 100:g} %", f"[{f.onset:g}, {f.end:g})"]
-              for f in scenario.faults]
-    t = r["tuning"]
-    tuning = [["UKF alpha, beta, kappa", f"{t['ukf']['alpha']:g}, {t['ukf']['beta']:g}, {t['ukf']['kappa']:g} "
+    fault_rows = [[f.thruster, f"{f.efficiency:g}", f"{(1 - f.efficiency) * 100:g} %", f"[{f.onset:g}, {f.end:g})"]
+                  for f in faults]
+    t, path = block_table(table, "ukf"), block_table(table, "guidance")
+    std = ", ".join(f"{np.sqrt(v):g}" for v in t["p0"])
+    tuning = [["UKF alpha, beta, kappa", f"{t['alpha']:g}, {t['beta']:g}, {t['kappa']:g} "
                "(lambda = 0: non-negative weights)"],
               ["models", ", ".join(f"{m} ({6 + len(th)} states{': alpha of ' + th[0] if th else ''})"
-                                   for m, th in MODELS.items())],
+                                   for m, th in t["models"].items())],
               ["Q, kinematic states", "G diag(alpha_d^2 / 3) G^T, G = d x_(k+1) / d tau_d of the RK4 step "
-                                      "(casadi.jacobian): the disturbance's own covariance through the sampled "
-                                      "model; positions isotropic (largest over headings), uncorrelated"],
-              ["Q, efficiency random walk", f"std {t['alpha_walk_std']:g} per sample"],
+                                      "(casadi.jacobian, `experiment.process_noise`; the file's q is checked "
+                                      "against it by the tests): the disturbance's own covariance through the "
+                                      "sampled model; positions isotropic (largest over headings), uncorrelated"],
+              ["Q, efficiency random walk", f"std {t['walk_std']:g} per sample"],
               ["R", "the sensor noise variances of the scenario"],
-              ["P0", f"std {', '.join(f'{v:g}' for v in t['P0_std'])} (x, y, psi, u, v, r, alpha)"],
+              ["P0", f"std {std}, {np.sqrt(t['efficiency_p0']):g} (x, y, psi, u, v, r, alpha)"],
               ["x0", "start of the path at the set speed; alpha = 1"],
               ["probability floor, prior",
-               f"{t['p_min']:g}; {', '.join(f'{p:g}' for p in t['prior'])} (no-fault, left, right)"],
-              ["federated reset", "every sample, kinematic states to the fused estimate" if t["reset"] else "off"],
+               f"{t['floor']:g}; {', '.join(f'{p:g}' for p in t['prior'])} (no-fault, left, right)"],
+              ["federated reset", "every sample, kinematic states to the fused estimate"
+               if t.get("reset", True) else "off"],
               ["measurements", "all six states (x, y, psi, u, v, r) with Gaussian noise"],
-              ["filters' model", "eqs. 1-3 in still water (no current parameters; the plant's current is 0), "
-                                 "RK4 over each sample as the plant"],
+              ["filters' model", "eqs. 1-3 with the plant's current parameters at 0 (still water) and the "
+                                 "random force at 0 (its effect is Q), RK4 over each sample as the plant"],
               ["UKF update", "the measurement is affine in x (y = x): its unscented moments are exact and are "
                              "evaluated in closed form; the prediction propagates 2n + 1 sigma points"],
-              ["controller", f"LOS (lookahead {scenario.path.lookahead:g} m, corners rounded at "
-                             f"{scenario.path.turn_radius:g} m) + speed PI (feed-forward d11 U) + heading PID"]]
-    noise = ", ".join(f"{k} {v:g}" for k, v in scenario.noise.items())
+              ["controller", f"LOS (lookahead {path['lookahead']:g} m, corners rounded at "
+                             f"{path['turn_radius']:g} m) + speed PI (feed-forward d11 U) + heading PID "
+                             "(the `autopilot` block)"],
+              ["where the banks run", "in the loop (`mmae` blocks), every sample, on the measurements and the "
+                                      "saturated commands"]]
+    alpha_d = ", ".join(f"{a:g}" for a in table["disturbance"]["uniform"].values())
+    waypoints = ", ".join(f"({a:g}, {b:g})" for a, b in path["waypoints"])
+    noise = ", ".join(f"{k} {v:g}" for k, v in table["noise"].items())
     diff, floor = r["ukf_minus_ekf_max_abs"], r["ukf_bank_with_floor_1e-3"]
     floor_delays = ", ".join(f"{_fmt(f['detect_delay_s'])} s" for f in floor["faults"])
     diff_states = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.endswith("_hat") and "." not in k)
     diff_p = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.startswith("p_"))
     figures = "\n\n".join(f"![{text}]({name})\n\n*{text}.*" for name, text in FIGURES.items())
+    events = [[f"{e['t']:g}", e["detector"], e["event"], e["target"] or "-", e["kind"] or "-",
+               "-" if e["value"] is None else f"{e['value']:.4f}"] for e in r["events"]]
+    rule = r["detectors"][0]
     return f"""# Thruster faults of the Otter USV: federated UKF and EKF banks with MMAE
 
 Reproduction of Li et al. 2025 (the FUKF-MMAE paper): {CITATION}
@@ -164,13 +189,14 @@ this report; the paper gives its results as figures only, so its claims are comp
 ## Plant and scenario
 
 The 3-DOF Otter (`uvsym.plant("otter3dof")`, the paper's eqs. 1-3) with the paper's random force
-`tau_d = alpha_d rand(t)` (eq. 6), alpha_d = {", ".join(f"{a:g}" for a in scenario.alpha_d)} (N, N, N m), one uniform
+`tau_d = alpha_d rand(t)` (eq. 6), alpha_d = {alpha_d} (N, N, N m), one uniform
 draw in [-1, 1] per sample and axis. It flies the rectangle of waypoints
-{", ".join(f"({a:g}, {b:g})" for a, b in scenario.path.waypoints)} m (north, east) at {scenario.speed:g} m/s
-under line-of-sight guidance (`uvsym.sim.controllers.LineOfSight`), sampled every {scenario.dt:g} s for
-{scenario.duration:g} s (scenario `{SCENARIO}`, seed {scenario.seed}). Sensor noise (standard deviations): {noise}.
+{waypoints} m (north, east) at {path["speed"]:g} m/s
+under line-of-sight guidance (`uvsym.sim.controllers.LineOfSight`), sampled every {table["step"]:g} s for
+{table["duration"]:g} s (scenario `{SCENARIO}`: `uvsym simulate {SCENARIO}`; noise seed {table["seed"]},
+disturbance seed {table["disturbance"]["seed"]}). Sensor noise (standard deviations): {noise}.
 
-{markdown_table(["thruster", "efficiency", "loss", "window (s)"], faults)}
+{markdown_table(["thruster", "efficiency", "loss", "window (s)"], fault_rows)}
 
 ## What the paper leaves out, and uvsym's choices
 
@@ -210,12 +236,12 @@ The paper's claims against this run:
 {markdown_table(["paper (Figs. 6-7)", "reproduced", "evidence"], _claims(r["banks"]))}
 
 Largest difference between the two banks over the run (UKF minus EKF): fused states
-{diff_states}; probabilities {diff_p}. With every state measured every {scenario.dt:g} s the
+{diff_states}; probabilities {diff_p}. With every state measured every {table["step"]:g} s the
 filters' covariances stay small, and over such a spread the Otter's model is nearly linear: the
 unscented transform and the EKF's linearisation then predict almost the same, which is what these
 differences measure.
 
-The floor: with {FLOOR_CHECK:g} (the floor first proposed for this reproduction) instead of {t['p_min']:g},
+The floor: with {FLOOR_CHECK:g} (the floor first proposed for this reproduction) instead of {t['floor']:g},
 the UKF bank's lowest p_nofault outside the windows is {floor['p_nofault_min_outside_windows']:.4g} instead of
 {r['p_nofault_min_outside_windows']:.4g} (delays {floor_delays}).
 On healthy stretches a fault model whose efficiency stays near 1 explains the disturbance about
@@ -226,6 +252,19 @@ RMS error of the fused estimate outside the fault windows:
 
 {markdown_table(["state", "UKF bank", "EKF bank"], rms)}
 
+## The banks' decisions
+
+Each bank is an `mmae` block in the loop; its detector (`type = "mmae"`,
+`uvsym.diagnosis.hypotheses`) publishes the bank's hypothesis switches into the event log: the
+leading hypothesis (most probable, above {rule["threshold"]:g}) for {rule["dwell_samples"]} sample(s) in a row
+becomes the decision; a thruster's hypothesis gives `detected` and `isolated` on it, then
+`identified` with its efficiency estimate once that estimate has stayed within
+{rule["identify_resolution"]:g} over {rule["identify_settle_samples"]} samples; the no-fault hypothesis gives `cleared`.
+`uvsym simulate {SCENARIO}` prints them:
+
+{markdown_table(["t (s)", "detector", "event", "target", "kind", "value"], events)}
+
+{campaign_section(r["campaign"])}
 ## Figures
 
 {figures}

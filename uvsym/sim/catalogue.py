@@ -26,6 +26,11 @@ hybrid           z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamm
 select           flag, on, off, output (signal names; on, off, output one name or n each): a
                  switch of the same sample, ``output = flag ? on : off`` (substitution from the
                  sample the flag rises; ``[substitutions]`` switch from the next sample)
+autopilot        waypoints, lookahead, turn_radius, acceptance, speed, speed_loop, heading_loop,
+                 mix, reads, limits, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
+mmae             filter (ukf, ekf), models (hypothesis = inputs with an efficiency state), q, r,
+                 p0, x0, efficiency_p0, walk_std, floor, prior, reset, steps, alpha, beta, kappa
+                 (:mod:`uvsym.observers.mmae_design`)
 ===============  ==============================================================================
 """
 
@@ -221,10 +226,22 @@ def _select(fields: Fields, plant: System, dt: float, name: str) -> Block:
     return select(name, flag=flag, on=on, off=off, output=output, unit=units.pop() if len(units) == 1 else "")
 
 
+def _autopilot(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.autopilot import autopilot_block
+
+    return autopilot_block(fields, plant, dt, name)
+
+
+def _mmae(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.observers.mmae_design import designed_bank
+
+    return observer_block(designed_bank(fields, plant, dt, name))
+
+
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
           "uio_bank": _uio_bank, "hybrid": hybrid_block,
-          "select": _select}
+          "select": _select, "autopilot": _autopilot, "mmae": _mmae}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

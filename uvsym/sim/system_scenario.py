@@ -7,7 +7,9 @@ Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
-``d``: constant disturbances), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
+``d``: constant disturbances), ``[disturbance]`` (``uniform``: a table of disturbance = amplitude
+a, drawn every sample as ``d + a U(-1, 1)``; ``seed``: of those draws, independent of the noise
+draws), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
 ``values``, ``interpolation`` "previous" or "linear": its schedule, sampled at every step and held
 over it, instead of its constant), ``[noise]`` (output = standard deviation of Gaussian noise, or
 output = ``{ uniform = bound }`` for noise uniform in ``[-bound, bound]``: the sensors'
@@ -42,6 +44,11 @@ switches in the same sample) and ``[[detectors]]``:
   ``<block>.f_<sensor>_hat`` of a hybrid block), ``estimate_gain`` (the sensor's fault direction:
   the identified offset is gain x estimate), ``identify_after`` and ``average`` (s): ``identified``
   with the mean estimate ``identify_after`` s after each detection.
+- ``type = "mmae"``: ``bank`` (an mmae block's name), ``threshold`` (probability, default 0.9),
+  ``dwell`` (samples, default 1), ``settle`` (samples, default 20) and ``resolution`` (default
+  0.02: an efficiency estimate is published where it stays within it over settle samples),
+  ``ignore_before`` (s), ``kind`` (default proportional): the
+  bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`).
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
@@ -71,7 +78,7 @@ from uvsym.sim.system_simulation import initial_state, loop_inputs
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
-__all__ = ["SystemScenario", "FlagSubstitution", "parse_system_scenario", "is_system_scenario",
+__all__ = ["SystemScenario", "FlagSubstitution", "RandomDisturbance", "parse_system_scenario", "is_system_scenario",
            "simulate_system_scenario", "parse_any_scenario", "simulate_any_scenario", "DETECTORS"]
 
 def is_system_scenario(table: dict) -> bool:
@@ -113,6 +120,7 @@ class SystemScenario:
     detectors: tuple
     substitutions: dict
     d_noise: np.ndarray | None = None  # (n_d,) standard deviations of the white disturbances; None: none
+    random_disturbance: RandomDisturbance | None = None
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -121,6 +129,31 @@ class SystemScenario:
     @property
     def output_labels(self) -> tuple[str, ...]:
         return self.plant.y.names
+
+
+@dataclass(frozen=True)
+class RandomDisturbance:
+    """Disturbances drawn every sample: ``amplitude * U(-1, 1)`` (n_d,) per row, from
+    ``numpy.random.default_rng(seed).uniform`` over all n_d columns at once."""
+
+    amplitude: np.ndarray
+    seed: int
+
+    def draws(self, N: int) -> np.ndarray:
+        """(N + 1, n_d) draws, one row per sample."""
+        return self.amplitude * np.random.default_rng(self.seed).uniform(-1.0, 1.0, size=(N + 1, self.amplitude.size))
+
+
+def _random_disturbance(fields: Fields | None, plant: System, seed: int) -> RandomDisturbance | None:
+    """The ``[disturbance]`` table (module docstring); its seed defaults to one past the noise seed."""
+    if fields is None:
+        return None
+    amplitude = _point(fields, "uniform", plant.d, np.zeros(plant.d.size))
+    if np.any(amplitude < 0):
+        raise ScenarioError(f"{fields._name('uniform')}: amplitudes must be >= 0, got {amplitude.tolist()}")
+    disturbance = RandomDisturbance(amplitude, fields.integer("seed", seed + 1, unit="disturbance draws"))
+    fields.done()
+    return disturbance
 
 
 def _close(name: str, known) -> str:
@@ -353,8 +386,15 @@ def _hybrid_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np
     return EstimatedFault(name, _threshold_detector(fields, name, scenario_loop, z0, w0, step), estimate, **options)
 
 
+def _mmae(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
+    """``type = "mmae"`` (:mod:`uvsym.diagnosis.hypotheses`, imported only for one)."""
+    from uvsym.diagnosis.hypotheses import mmae_detector
+
+    return mmae_detector(fields, name, scenario_loop, z0, w0, step)
+
+
 DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands,
-             "hybrid": _hybrid_detector}
+             "hybrid": _hybrid_detector, "mmae": _mmae}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
@@ -403,6 +443,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
     d = _disturbances(top.tables("disturbances"), plant, d, round(duration / step), step)
+    random_disturbance = _random_disturbance(top.table("disturbance"), plant, seed)
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number or table", "standard deviation of the output's Gaussian sensor noise, "
                  "or { uniform = bound } (its unit)", "none")
@@ -460,7 +501,8 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
                           loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                           supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
-                          detectors=tuple(detectors), substitutions=by, d_noise=d_noise if d_noise.any() else None)
+                          detectors=tuple(detectors), substitutions=by, d_noise=d_noise if d_noise.any() else None,
+                          random_disturbance=random_disturbance)
 
 
 
@@ -489,6 +531,8 @@ def scenario_inputs(scenario: SystemScenario) -> np.ndarray:
     d = scenario.d
     if scenario.d_noise is not None:
         d = d + scenario.d_noise * disturbance_draws(N, scenario.plant.d.size, scenario.seed)
+    if scenario.random_disturbance is not None:
+        d = d + scenario.random_disturbance.draws(N)
     return loop_inputs(scenario.loop, N, d, scenario.seed)
 
 

@@ -1,4 +1,4 @@
-/* Example: one call of uvsym_otter_ukf_mmae_ukf_bank_step on zero inputs (the observer set gives no example data: put yours here).
+/* Example: one call of uvsym_otter_ukf_mmae_ukf_step on zero inputs (the observer set gives no example data: put yours here).
    Prints each output on one line: its name, then its entries (units: README.md, manifest.json). */
 #include <stdio.h>
 #include "uvsym_otter_ukf_mmae.h"
@@ -8,12 +8,12 @@ int main(void) {
   static const uvsym_otter_ukf_mmae_real s[100] = {0};
   static const uvsym_otter_ukf_mmae_real y[6] = {0};
   static const uvsym_otter_ukf_mmae_real u[2] = {0};
-  const uvsym_otter_ukf_mmae_real* p = NULL;
+  static const uvsym_otter_ukf_mmae_real p[2] = {0};
   uvsym_otter_ukf_mmae_real s_next[100];
   uvsym_otter_ukf_mmae_real out[16];
-  rc = uvsym_otter_ukf_mmae_ukf_bank_step(s, y, u, p, s_next, out);
+  rc = uvsym_otter_ukf_mmae_ukf_step(s, y, u, p, s_next, out);
   if (rc != UVSYM_OTTER_UKF_MMAE_OK) {
-    fprintf(stderr, "uvsym_otter_ukf_mmae_ukf_bank_step returned %d\n", rc);
+    fprintf(stderr, "uvsym_otter_ukf_mmae_ukf_step returned %d\n", rc);
     return 1;
   }
   printf("s_next");

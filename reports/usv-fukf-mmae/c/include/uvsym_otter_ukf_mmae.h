@@ -125,7 +125,9 @@ typedef double uvsym_otter_ukf_mmae_real;
  * in  u[2]: inputs
  *       [0] T_L [N]
  *       [1] T_R [N]
- * in  p[0]: parameters
+ * in  p[2]: parameters
+ *       [0] V_c [m/s]
+ *       [1] beta_c [rad]
  * out s_next[100]: next observer state
  *       [0] nofault.x_hat [m]
  *       [1] nofault.y_hat [m]
@@ -246,6 +248,6 @@ typedef double uvsym_otter_ukf_mmae_real;
  *       [15] skipped [-]
  * Returns UVSYM_OTTER_UKF_MMAE_OK, UVSYM_OTTER_UKF_MMAE_EVAL_FAILED, UVSYM_OTTER_UKF_MMAE_NONFINITE_INPUT or UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT.
  * Uses static work buffers: not reentrant. */
-int uvsym_otter_ukf_mmae_ukf_bank_step(const uvsym_otter_ukf_mmae_real s[100], const uvsym_otter_ukf_mmae_real y[6], const uvsym_otter_ukf_mmae_real u[2], const uvsym_otter_ukf_mmae_real* p, uvsym_otter_ukf_mmae_real s_next[100], uvsym_otter_ukf_mmae_real out[16]);
+int uvsym_otter_ukf_mmae_ukf_step(const uvsym_otter_ukf_mmae_real s[100], const uvsym_otter_ukf_mmae_real y[6], const uvsym_otter_ukf_mmae_real u[2], const uvsym_otter_ukf_mmae_real p[2], uvsym_otter_ukf_mmae_real s_next[100], uvsym_otter_ukf_mmae_real out[16]);
 
 #endif /* UVSYM_OTTER_UKF_MMAE_H */

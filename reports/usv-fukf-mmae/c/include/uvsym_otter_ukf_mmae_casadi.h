@@ -17,24 +17,24 @@ extern "C" {
 #define casadi_int long long int
 #endif
 
-int uvsym_otter_ukf_mmae_casadi_ukf_bank_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
-int uvsym_otter_ukf_mmae_casadi_ukf_bank_step_checkout(void);
-void uvsym_otter_ukf_mmae_casadi_ukf_bank_step_release(int mem);
-void uvsym_otter_ukf_mmae_casadi_ukf_bank_step_incref(void);
-void uvsym_otter_ukf_mmae_casadi_ukf_bank_step_decref(void);
-casadi_int uvsym_otter_ukf_mmae_casadi_ukf_bank_step_n_in(void);
-casadi_int uvsym_otter_ukf_mmae_casadi_ukf_bank_step_n_out(void);
-casadi_real uvsym_otter_ukf_mmae_casadi_ukf_bank_step_default_in(casadi_int i);
-const char* uvsym_otter_ukf_mmae_casadi_ukf_bank_step_name_in(casadi_int i);
-const char* uvsym_otter_ukf_mmae_casadi_ukf_bank_step_name_out(casadi_int i);
-const casadi_int* uvsym_otter_ukf_mmae_casadi_ukf_bank_step_sparsity_in(casadi_int i);
-const casadi_int* uvsym_otter_ukf_mmae_casadi_ukf_bank_step_sparsity_out(casadi_int i);
-int uvsym_otter_ukf_mmae_casadi_ukf_bank_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-int uvsym_otter_ukf_mmae_casadi_ukf_bank_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-#define uvsym_otter_ukf_mmae_casadi_ukf_bank_step_SZ_ARG 4
-#define uvsym_otter_ukf_mmae_casadi_ukf_bank_step_SZ_RES 2
-#define uvsym_otter_ukf_mmae_casadi_ukf_bank_step_SZ_IW 0
-#define uvsym_otter_ukf_mmae_casadi_ukf_bank_step_SZ_W 0
+int uvsym_otter_ukf_mmae_casadi_ukf_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int uvsym_otter_ukf_mmae_casadi_ukf_step_checkout(void);
+void uvsym_otter_ukf_mmae_casadi_ukf_step_release(int mem);
+void uvsym_otter_ukf_mmae_casadi_ukf_step_incref(void);
+void uvsym_otter_ukf_mmae_casadi_ukf_step_decref(void);
+casadi_int uvsym_otter_ukf_mmae_casadi_ukf_step_n_in(void);
+casadi_int uvsym_otter_ukf_mmae_casadi_ukf_step_n_out(void);
+casadi_real uvsym_otter_ukf_mmae_casadi_ukf_step_default_in(casadi_int i);
+const char* uvsym_otter_ukf_mmae_casadi_ukf_step_name_in(casadi_int i);
+const char* uvsym_otter_ukf_mmae_casadi_ukf_step_name_out(casadi_int i);
+const casadi_int* uvsym_otter_ukf_mmae_casadi_ukf_step_sparsity_in(casadi_int i);
+const casadi_int* uvsym_otter_ukf_mmae_casadi_ukf_step_sparsity_out(casadi_int i);
+int uvsym_otter_ukf_mmae_casadi_ukf_step_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+int uvsym_otter_ukf_mmae_casadi_ukf_step_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+#define uvsym_otter_ukf_mmae_casadi_ukf_step_SZ_ARG 4
+#define uvsym_otter_ukf_mmae_casadi_ukf_step_SZ_RES 2
+#define uvsym_otter_ukf_mmae_casadi_ukf_step_SZ_IW 0
+#define uvsym_otter_ukf_mmae_casadi_ukf_step_SZ_W 0
 void uvsym_otter_ukf_mmae_casadi__casadi_version(int* major, int* minor, int* patch);
 int uvsym_otter_ukf_mmae_casadi__casadi_int_size(void);
 int uvsym_otter_ukf_mmae_casadi__casadi_real_size(void);
