@@ -218,41 +218,23 @@ def test_unknown_observer_sets_and_options_are_refused_by_name():
         observer_set("actuator-observers", colour="red")
 
 
-def test_a_study_scenario_runs_through_its_derivation_and_bad_study_fields_are_named(monkeypatch, tmp_path, capsys):
-    import numpy as np
-
+def test_a_derivations_shipped_scenario_runs_by_name_and_an_old_study_file_is_told_what_to_name(
+        monkeypatch, tmp_path, capsys):
     from uvsym.derivation import Derivation
-    from uvsym.errors import ScenarioError
-    from uvsym.sim.result import Signal, SimResult
-
-    seen = {}
-
-    def simulate(table, name, progress, method=None):
-        gain = table.get("gain")
-        if not isinstance(gain, (int, float)) or gain <= 0:
-            raise ScenarioError(f"gain: expected a positive number, got {gain!r}")
-        seen.update(table=table, name=name, method=method)
-        t = np.linspace(0.0, 1.0, 5)
-        return SimResult(t, {"y": Signal(gain * t[:, None], ("y",), ("m",))}, {"wall_s": 0.01})
 
     shipped = tmp_path / "toy_run.toml"
-    shipped.write_text('study = "toy"\ngain = 2.0\n')
-    toy = Derivation("toy", "Toy", lambda out_dir, progress: None, simulate=simulate, scenarios={"toy_run": shipped})
+    shipped.write_text('plant = "rov_yaw"\nduration = 2.0\nstep = 0.1\n[[blocks]]\ntype = "open_loop"\n'
+                       'name = "thrust"\npublishes = "u"\ntimes = [0.0]\nvalues = [0.1]\n')
+    toy = Derivation("toy", "Toy", lambda out_dir, progress: None, scenarios={"toy_run": shipped})
     _install(monkeypatch, toy=toy)
     assert main(["simulate", "--list"]) == 0
     assert any(line.split()[:2] == ["toy_run", "toy"] for line in capsys.readouterr().out.splitlines())
     assert main(["simulate", "toy_run", "--out", str(tmp_path / "run.npz")]) == 0
-    assert seen == {"table": {"gain": 2.0}, "name": "toy_run", "method": None}
-    assert (tmp_path / "run.npz").exists() and "study toy" in capsys.readouterr().out
-    bad = tmp_path / "bad.toml"
-    bad.write_text('study = "toy"\ngain = -1\n')
-    assert main(["simulate", str(bad)]) == 2
-    assert "gain: expected a positive number, got -1" in capsys.readouterr().err
-    bad.write_text('study = "nosuch"\n')
-    assert main(["simulate", str(bad)]) == 2
-    assert "study: unknown derivation 'nosuch'" in capsys.readouterr().err
-    # scenario files that name their plant need no simulate hook
-    assert Derivation("x", "X", lambda out_dir, progress: None, scenarios={"a": shipped}).scenarios["a"] == shipped
+    assert (tmp_path / "run.npz").exists() and "toy_run: rov_yaw, 2 s at 0.1 s" in capsys.readouterr().out
+    old = tmp_path / "old.toml"
+    old.write_text('study = "toy"\ngain = -1\n')           # the format before scenarios over a plant
+    assert main(["simulate", str(old)]) == 2
+    assert "a scenario over any other System its plant (plant = NAME or module:function" in capsys.readouterr().err
 
 
 def test_the_source_fingerprint_moves_with_any_source_file_of_the_study(tmp_path, monkeypatch):

@@ -24,8 +24,8 @@ def test_misspelt_fields_are_pointed_at():
     data["durration"] = data.pop("duration")
     with pytest.raises(ScenarioError, match=r"duration: required number is missing \(is 'durration' a misspelt"):
         parse_scenario(data)
-    with pytest.raises(ScenarioError, match=r"vehicle: missing; .* is 'studdy' a misspelt 'study'\?"):
-        parse_scenario({"studdy": "sensor-fdi-lms"})
+    with pytest.raises(ScenarioError, match=r"vehicle: missing; .* is 'plnat' a misspelt 'plant'\?"):
+        parse_scenario({"plnat": "rov_yaw"})
     data = _docking()
     data["controller"]["path"]["lookahed"] = 5.0
     with pytest.raises(ScenarioError, match=r"path\.lookahed: unknown field \(did you mean 'lookahead'\?\)"):

@@ -20,7 +20,7 @@ from uvsym.sim.fields import Fields
 
 def test_registered_with_its_scenario_file():
     study = derivation("usv-fukf-mmae")
-    assert study.simulate is None and study_scenarios()["otter_thruster_faults"][0] == "usv-fukf-mmae"
+    assert not hasattr(study, "simulate") and study_scenarios()["otter_thruster_faults"][0] == "usv-fukf-mmae"
     sc = parsed(read())
     assert (sc.step, sc.duration) == (0.05, 300.0)
     assert thruster_faults(sc) == (ThrusterFault("T_L", 0.4, 100.0, 150.0), ThrusterFault("T_R", 0.3, 200.0, 250.0))

@@ -152,27 +152,6 @@ def _scenario_path(source: str) -> Path:
     return shipped[source]
 
 
-def _simulate_study(study_name, table: dict, name: str, method: str | None):
-    """Run a derivation's scenario (top-level ``study = NAME``) with a progress bar."""
-    from uvsym.errors import ScenarioError
-    from uvsym.progress import ProgressBar
-
-    if not isinstance(study_name, str):
-        raise ScenarioError(f"study: expected the name of a derivation, got {study_name!r}")
-    try:
-        study = derivation(study_name)
-    except UnknownNameError as exc:
-        raise ScenarioError(f"study: {exc}") from None
-    if study.simulate is None:
-        raise ScenarioError(f"study: derivation {study_name!r} runs no scenarios")
-    bar = ProgressBar(f"{name} ({study_name})")
-    result = study.simulate(table, name=name, progress=bar, method=method)
-    bar.close()
-    print(f"{name}: study {study_name}, {result.t[-1] - result.t[0]:g} s, "
-          f"{result.meta.get('wall_s', float('nan')):.3g} s wall; signals: {', '.join(result.signals)}")
-    return result
-
-
 def _cmd_simulate(args) -> int:
     from uvsym.campaign.metrics import detector_names
     from uvsym.derivation import study_scenarios
@@ -196,28 +175,24 @@ def _cmd_simulate(args) -> int:
     if args.out:  # format, folder and an existing file checked before the run
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
-    scenario = None if "study" in table else parse_any_scenario(table, default_name=path.stem, root=path.parent)
+    scenario = parse_any_scenario(table, default_name=path.stem, root=path.parent)
     if args.events is not None:
         _check_events_path(args.events, scenario, args.force)
     figure = None
     if args.plot is not None:  # the figure checked like the result, before the run
-        default = Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name if scenario else path.stem}.svg"
+        default = Path(args.out).with_suffix(".svg") if args.out else f"{scenario.name}.svg"
         figure = SimResult.check_plot_path(args.plot or default, overwrite=args.force)
-    if scenario is None:
-        table = dict(table)
-        result = _simulate_study(table.pop("study"), table, path.stem, args.method)
-    else:
-        method = args.method or "fast"
-        bar = ProgressBar(f"{scenario.name} ({method})")
-        result = simulate_any_scenario(scenario, method=method, progress=bar)
-        what = (scenario.plant if hasattr(scenario, "plant") else scenario.model).name
-        bar.close()
-        wall = result.meta["wall_s"]
-        print(f"{scenario.name}: {what}, {scenario.duration:g} s at {scenario.step:g} s, method "
-              f"{method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
-              f"build {result.meta['build_s']:.2f} s")
-        x = result["x"]
-        print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
+    method = args.method or "fast"
+    bar = ProgressBar(f"{scenario.name} ({method})")
+    result = simulate_any_scenario(scenario, method=method, progress=bar)
+    what = (scenario.plant if hasattr(scenario, "plant") else scenario.model).name
+    bar.close()
+    wall = result.meta["wall_s"]
+    print(f"{scenario.name}: {what}, {scenario.duration:g} s at {scenario.step:g} s, method "
+          f"{method}: {wall:.3g} s wall ({scenario.duration / wall:,.0f} simulated s per wall s), "
+          f"build {result.meta['build_s']:.2f} s")
+    x = result["x"]
+    print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
         print(f"wrote {result.save(args.out, overwrite=args.force)}")
     if detector_names(scenario):  # a vehicle's [diagnosis] table, or [[detectors]]

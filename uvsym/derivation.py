@@ -16,11 +16,9 @@ What a derivation implements:
   (a negative control expects ``"refuted"``);
 - ``observer_sets``, optional: set name -> factory that takes keyword options with defaults
   (``vehicle``, ``form``, ...) and returns an :class:`~uvsym.codegen.observer_sets.ObserverSet`;
-- ``simulate``, optional: ``simulate(table, name=..., progress=..., method=None) -> SimResult`` runs
-  a scenario of this study given as the parsed TOML ``table`` (without its ``study`` key); it
-  validates every field and raises :class:`~uvsym.errors.ScenarioError` naming the field;
-- ``scenarios``, optional: shipped example scenario name -> TOML path (a scenario file naming its
-  ``plant``, run by :mod:`uvsym.sim.system_scenario`, or one with ``study = NAME`` run by ``simulate``).
+- ``scenarios``, optional: shipped example scenario name -> TOML path, each a scenario over a plant
+  (:mod:`uvsym.sim.system_scenario`) that ``uvsym simulate``, ``uvsym campaign``, ``uvsym codegen``
+  and ``uvsym verify`` take by its name.
 
 What it gets for free:
 
@@ -29,8 +27,7 @@ What it gets for free:
   status 1 when a claim is not as expected;
 - ``uvsym codegen SET -o DIR [--vehicle V] [--form F] [--float]``: the set as a C99 package,
   options passed to the factory only when given; ``uvsym codegen --list`` lists every set;
-- ``uvsym simulate FILE.toml`` for a TOML whose top-level ``study = NAME`` names it (``--out``,
-  ``--plot`` as for every scenario), and its shipped scenarios in ``uvsym simulate --list``.
+- its shipped scenarios in ``uvsym simulate --list``, run by name like uvsym's own.
 
 Paper-specific numbers (vehicles, gains, faults, the paper's values) belong in the derivation;
 nothing in ``uvsym`` imports one.
@@ -49,7 +46,6 @@ from uvsym.codegen.observer_sets import ObserverSet, make_observer_set
 from uvsym.errors import DerivationError, UnknownNameError
 
 if TYPE_CHECKING:
-    from uvsym.sim.result import SimResult
     from uvsym.verify.certificate import Certificate
 
 __all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivations", "observer_set",
@@ -67,7 +63,6 @@ class Derivation:
     build: Callable[[Path, Callable[[str], None]], None]
     claims: Callable[[], list[Certificate]] | None = None
     observer_sets: Mapping[str, Callable[..., ObserverSet]] = field(default_factory=dict)
-    simulate: Callable[..., SimResult] | None = None
     scenarios: Mapping[str, Path] = field(default_factory=dict)
 
     def __post_init__(self):
@@ -77,28 +72,13 @@ class Derivation:
         if not isinstance(self.scenarios, Mapping):
             raise DerivationError(f"derivation {self.name!r}: scenarios must map names to TOML paths, "
                                   f"got {type(self.scenarios).__name__}")
-        studied = [name for name, path in self.scenarios.items() if _names_a_study(Path(path))]
-        if studied and self.simulate is None:
-            raise DerivationError(f"derivation {self.name!r}: ships scenarios but has no simulate for their "
-                                  f"study = ... tables ({', '.join(studied)})")
         parts = {"build": self.build, **({} if self.claims is None else {"claims": self.claims}),
-                 **({} if self.simulate is None else {"simulate": self.simulate}),
                  **{f"observer set {k!r}": f for k, f in self.observer_sets.items()}}
         bad = [part for part, f in parts.items() if not callable(f)]
         if bad:
             raise DerivationError(f"derivation {self.name!r}: not callable: {', '.join(bad)}")
         object.__setattr__(self, "observer_sets", MappingProxyType(dict(self.observer_sets)))
         object.__setattr__(self, "scenarios", MappingProxyType({k: Path(v) for k, v in self.scenarios.items()}))
-
-
-def _names_a_study(path: Path) -> bool:
-    """True for a scenario file with a top-level ``study = ...`` (run by its derivation's simulate)."""
-    import tomllib
-
-    try:
-        return "study" in tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError):
-        return False  # reading it fails later, naming the file
 
 
 def _entry_points() -> dict[str, EntryPoint]:

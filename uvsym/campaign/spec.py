@@ -201,9 +201,6 @@ def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
         table = read_scenario_file(path)
     except ScenarioError as exc:
         raise CampaignError(f"{fields.path}.scenario: {exc}") from None
-    if "study" in table:
-        raise CampaignError(f"{fields.path}.scenario: {path.name} is a derivation's scenario (study = ...); "
-                            "campaigns run vehicle scenarios and scenarios over a plant (plant = ...)")
     if is_system_scenario(table) and ":" in str(table["plant"]):
         table.setdefault("plant_path", str(path.parent.resolve()))  # the plant's module, beside its scenario
     return table, path.stem

@@ -89,6 +89,8 @@ def autopilot_block(fields: Fields, plant: System, dt: float, name: str) -> Bloc
     autopilot = Autopilot(speed=_loop(fields, "speed_loop", speed), heading=_loop(fields, "heading_loop", 0.0),
                           path=path, outputs=_mix(fields, plant))
     default = plant.x.names if plant.x.size == 6 else None
+    fields.describe("reads", "string or list of strings", "the 6 signals read as x, y, psi, u, v, r (m, rad, m/s, "
+                    "rad/s)", "the plant's states, for a 3-DOF vehicle")
     reads = _group(plant, _names(fields, "reads", default, size=6), fields.path, "read")
     saturate = fields.raw("saturate", True, "boolean", "clamp to the plant's input limits")
     if not isinstance(saturate, bool):

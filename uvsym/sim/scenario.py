@@ -155,10 +155,10 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
     name = top.text("name", default_name)
     description = top.text("description", "")
     if "vehicle" not in data:
-        near = difflib.get_close_matches("study", [str(k) for k in data], n=1, cutoff=0.7)
-        raise ScenarioError("vehicle: missing; a vehicle scenario names its vehicle (vehicle = NAME, see uvsym "
-                            "models), a derivation's scenario its study (study = NAME)"
-                            + (f"; is {near[0]!r} a misspelt 'study'?" if near else ""))
+        near = difflib.get_close_matches("plant", [str(k) for k in data], n=1, cutoff=0.7)
+        raise ScenarioError("vehicle: missing; a vehicle scenario names its vehicle (vehicle = NAME), a scenario "
+                            "over any other System its plant (plant = NAME or module:function; see uvsym models)"
+                            + (f"; is {near[0]!r} a misspelt 'plant'?" if near else ""))
     vehicle_name = top.text("vehicle")
     overrides = top.raw("vehicle_parameters", {}, "table", "parameter = value overrides (uvsym models show VEHICLE)")
     if not isinstance(overrides, dict):
