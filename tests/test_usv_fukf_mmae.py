@@ -95,7 +95,7 @@ def test_nees_of_the_no_fault_ukf_on_healthy_runs_is_within_its_chi_square_bound
     for seed in range(runs):
         table = read()
         table.update(seed=50 + seed, duration=15.0, faults=[], detectors=[])
-        table["disturbance"]["seed"] = 150 + seed
+        table["disturbance_seed"] = 150 + seed
         table["blocks"] = [block_table(table, "guidance")]
         result = experiment.run(parsed(table))
         commands = result["guidance"].values[:, [result["guidance"].labels.index(n) for n in ("T_L", "T_R")]]

@@ -111,10 +111,11 @@ def test_the_files_numbers_follow_from_the_model():
     for name in ("ukf", "ekf"):
         bank = block_table(table, name)
         np.testing.assert_array_equal(np.asarray(bank["q"]), experiment.process_noise((6.0, 6.0, 3.0), 0.05, 1.5, 0.0))
-        np.testing.assert_allclose(bank["r"], np.array(list(table["noise"].values())) ** 2, rtol=1e-12)
+        sensors = [v for v in table["noise"].values() if not isinstance(v, dict)]   # the random force aside
+        np.testing.assert_allclose(bank["r"], np.array(sensors) ** 2, rtol=1e-12)
     feedforward = block_table(table, "guidance")["speed_loop"]["feedforward"]
     assert feedforward == experiment.surge_damping() * 1.5
-    assert list(table["disturbance"]["uniform"].values()) == [6.0, 6.0, 3.0]
+    assert [table["noise"][k]["uniform"] for k in ("tau_u", "tau_v", "tau_r")] == [6.0, 6.0, 3.0]
 
 
 def _bad(edit) -> str:
@@ -139,8 +140,9 @@ def _bad(edit) -> str:
     (lambda t: t["blocks"][0].update(turn_radius=200.0), r"blocks\[0\]\.turn_radius: 200(\.0)? m is too large"),
     (lambda t: t["blocks"][0]["heading_loop"].update(kq=1.0), r"blocks\[0\]\.heading_loop\.kq: unknown field"),
     (lambda t: t["blocks"][0].pop("speed_loop"), r"blocks\[0\]\.speed_loop: required table"),
-    (lambda t: t["disturbance"]["uniform"].update(tau_x=1.0), r"disturbance\.uniform\.tau_x: unknown disturbance"),
-    (lambda t: t["disturbance"]["uniform"].update(tau_u=-1.0), r"disturbance\.uniform: amplitudes must be >= 0"),
+    (lambda t: t["noise"].update(tau_x={"uniform": 1.0}), r"noise\.tau_x: unknown output or disturbance .*disturbances: tau_u, tau_v, tau_r"),
+    (lambda t: t["noise"].update(tau_u={"uniform": -1.0}), r"noise\.tau_u\.uniform: must be positive"),
+    (lambda t: t["noise"].update(tau_u={"unifrom": 1.0}), r"noise\.tau_u\.unifrom: unknown field"),
     (lambda t: t["detectors"][0].update(bank="ukff"), r"detectors\[0\]\.bank: 'ukff' is not an mmae block of the "
                                                       r"scenario \(did you mean 'ukf'\?\)"),
     (lambda t: t["detectors"][0].update(bank="guidance"), r"detectors\[0\]\.bank: 'guidance' is not an mmae block"),
@@ -212,16 +214,18 @@ def test_a_growing_fault_is_identified_again_where_its_estimate_settles():
 
 def test_random_disturbances_are_bounded_by_their_amplitudes_and_seeded_apart_from_the_noise():
     table = read()
-    table["disturbance"] = {"uniform": {"tau_u": 6.0, "tau_r": 3.0}}
+    table["noise"] = {k: v for k, v in table["noise"].items() if not k.startswith("tau_")}
+    table["noise"] |= {"tau_u": {"uniform": 6.0}, "tau_r": {"uniform": 3.0}, "tau_v": 0.5}
+    table.pop("disturbance_seed")
     table.update(seed=7)
-    disturbance = parsed(table).random_disturbance
-    assert disturbance.seed == 8  # default: one past the noise seed
+    disturbance = parsed(table).disturbance_noise
+    assert disturbance.seed == (7, 1)  # default: its own stream of the noise seed
     draws = disturbance.draws(4000)
-    assert draws.shape == (4001, 3) and np.all(draws[:, 1] == 0.0)
+    assert draws.shape == (4001, 3) and abs(np.std(draws[:, 1]) - 0.5) < 0.02     # Gaussian tau_v
     assert np.all(np.abs(draws[:, 0]) <= 6.0) and np.max(np.abs(draws[:, 0])) > 5.9
     assert np.all(np.abs(draws[:, 2]) <= 3.0) and abs(np.std(draws[:, 2]) - 3.0 / np.sqrt(3.0)) < 0.05
-    table["disturbance"]["seed"] = 9
-    assert not np.allclose(parsed(table).random_disturbance.draws(10), draws[:11])
+    table["disturbance_seed"] = 9
+    assert not np.allclose(parsed(table).disturbance_noise.draws(10), draws[:11])
 
 
 def test_the_campaign_covers_both_thrusters_profiles_noise_levels_and_healthy_hours():

@@ -1,8 +1,8 @@
 """The Otter with the paper's random force, and where the shipped scenario's tuning comes from.
 
 Plant: ``uvsym.plant("otter3dof")`` plus the paper's random force ``tau_d = alpha_d rand(t)``
-(eq. 6) as disturbances, ``nu' += M^-1 tau_d``; the scenario draws them (``[disturbance]``,
-uniform, one draw per sample and axis). Loop (the scenario file): line-of-sight guidance with
+(eq. 6) as disturbances, ``nu' += M^-1 tau_d``; the scenario draws them (``[noise]``,
+``{ uniform = alpha }`` per axis, one draw per sample). Loop (the scenario file): line-of-sight guidance with
 speed and heading PID (the ``autopilot`` block), thrust commands saturated at the thrusters'
 limits, thruster faults ``T_i = eta_i T_bar_i`` on their windows, every state measured with
 Gaussian noise; the UKF and EKF banks (``mmae`` blocks) read the measurements and the saturated

@@ -164,9 +164,9 @@ def _report(r: dict, table: dict, faults) -> str:
                              "(the `autopilot` block)"],
               ["where the banks run", "in the loop (`mmae` blocks), every sample, on the measurements and the "
                                       "saturated commands"]]
-    alpha_d = ", ".join(f"{a:g}" for a in table["disturbance"]["uniform"].values())
+    alpha_d = ", ".join(f"{v['uniform']:g}" for v in table["noise"].values() if isinstance(v, dict))
     waypoints = ", ".join(f"({a:g}, {b:g})" for a, b in path["waypoints"])
-    noise = ", ".join(f"{k} {v:g}" for k, v in table["noise"].items())
+    noise = ", ".join(f"{k} {v:g}" for k, v in table["noise"].items() if not isinstance(v, dict))
     diff, floor = r["ukf_minus_ekf_max_abs"], r["ukf_bank_with_floor_1e-3"]
     floor_delays = ", ".join(f"{_fmt(f['detect_delay_s'])} s" for f in floor["faults"])
     diff_states = ", ".join(f"{k} {v:.2g}" for k, v in diff.items() if k.endswith("_hat") and "." not in k)
@@ -194,7 +194,7 @@ draw in [-1, 1] per sample and axis. It flies the rectangle of waypoints
 {waypoints} m (north, east) at {path["speed"]:g} m/s
 under line-of-sight guidance (`uvsym.sim.controllers.LineOfSight`), sampled every {table["step"]:g} s for
 {table["duration"]:g} s (scenario `{SCENARIO}`: `uvsym simulate {SCENARIO}`; noise seed {table["seed"]},
-disturbance seed {table["disturbance"]["seed"]}). Sensor noise (standard deviations): {noise}.
+disturbance seed {table["disturbance_seed"]}). Sensor noise (standard deviations): {noise}.
 
 {markdown_table(["thruster", "efficiency", "loss", "window (s)"], fault_rows)}
 

@@ -7,19 +7,17 @@ Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
 ``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
-``d``: constant disturbances), ``[disturbance]`` (``uniform``: a table of disturbance = amplitude
-a, drawn every sample as ``d + a U(-1, 1)``; ``seed``: of those draws, independent of the noise
-draws), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
+``d``: constant disturbances), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
 ``values``, ``interpolation`` "previous" or "linear": its schedule, sampled at every step and held
 over it, instead of its constant), ``[noise]`` (output = standard deviation of Gaussian noise, or
 output = ``{ uniform = bound }`` for noise uniform in ``[-bound, bound]``: the sensors'
 specification, acting the whole run; the threshold calibration linearises the noise at its draw 0,
 so it takes uniform noise for Gaussian noise of standard deviation ``bound sqrt(2 / pi)``, above
-its true ``bound / sqrt 3``; disturbance = standard deviation of a white disturbance held over
-each sample and added to ``d``, drawn from its own seeded stream,
-:func:`~uvsym.sim.loop.disturbance_draws`), ``[[setpoints]]`` (``signal``, ``times`` s, ``values``,
-``interpolation``: a schedule published as ``signal``), ``[[blocks]]`` (controllers and
-estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
+its true ``bound / sqrt 3``; disturbance = the same, a random disturbance drawn every sample,
+held over it and added to ``d``: :class:`DisturbanceNoise`, seeded by ``disturbance_seed``,
+default the stream ``(seed, 1)``, independent of the sensor noise), ``[[setpoints]]``
+(``signal``, ``times`` s, ``values``, ``interpolation``: a schedule published as ``signal``),
+``[[blocks]]`` (controllers and estimators, :mod:`uvsym.sim.catalogue`), ``[[faults]]`` (``actuator`` = an input name or
 ``sensor`` = an output name, ``kind``, ``value`` and the profile fields of vehicle scenarios),
 ``[substitutions]`` (``channel = { by = "signal", when = "flag signal" }``: while the flag is set
 every block reading channel reads the substitute, from the next sample; a ``select`` block
@@ -78,7 +76,7 @@ from uvsym.sim.system_simulation import initial_state, loop_inputs
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
-__all__ = ["SystemScenario", "FlagSubstitution", "RandomDisturbance", "parse_system_scenario", "is_system_scenario",
+__all__ = ["SystemScenario", "FlagSubstitution", "DisturbanceNoise", "parse_system_scenario", "is_system_scenario",
            "simulate_system_scenario", "parse_any_scenario", "simulate_any_scenario", "DETECTORS"]
 
 def is_system_scenario(table: dict) -> bool:
@@ -119,8 +117,7 @@ class SystemScenario:
     supervisor: FlagSubstitution | None
     detectors: tuple
     substitutions: dict
-    d_noise: np.ndarray | None = None  # (n_d,) standard deviations of the white disturbances; None: none
-    random_disturbance: RandomDisturbance | None = None
+    disturbance_noise: DisturbanceNoise | None = None
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -132,28 +129,25 @@ class SystemScenario:
 
 
 @dataclass(frozen=True)
-class RandomDisturbance:
-    """Disturbances drawn every sample: ``amplitude * U(-1, 1)`` (n_d,) per row, from
-    ``numpy.random.default_rng(seed).uniform`` over all n_d columns at once."""
+class DisturbanceNoise:
+    """Random disturbances drawn every sample and held over it, added to ``d``: ``bound U(-1, 1)`` where
+    a bound is given, then ``std N(0, 1)`` where a standard deviation is, (n_d,) each, all columns
+    drawn at once from ``numpy.random.default_rng(seed)`` (uniform draws first); the default seed is
+    the stream ``(noise seed, 1)``, independent of the sensor noise's."""
 
-    amplitude: np.ndarray
-    seed: int
+    std: np.ndarray
+    bound: np.ndarray
+    seed: int | tuple[int, int]
 
     def draws(self, N: int) -> np.ndarray:
         """(N + 1, n_d) draws, one row per sample."""
-        return self.amplitude * np.random.default_rng(self.seed).uniform(-1.0, 1.0, size=(N + 1, self.amplitude.size))
-
-
-def _random_disturbance(fields: Fields | None, plant: System, seed: int) -> RandomDisturbance | None:
-    """The ``[disturbance]`` table (module docstring); its seed defaults to one past the noise seed."""
-    if fields is None:
-        return None
-    amplitude = _point(fields, "uniform", plant.d, np.zeros(plant.d.size))
-    if np.any(amplitude < 0):
-        raise ScenarioError(f"{fields._name('uniform')}: amplitudes must be >= 0, got {amplitude.tolist()}")
-    disturbance = RandomDisturbance(amplitude, fields.integer("seed", seed + 1, unit="disturbance draws"))
-    fields.done()
-    return disturbance
+        rng, shape = np.random.default_rng(self.seed), (N + 1, self.std.size)
+        out = np.zeros(shape)
+        if self.bound.any():
+            out += self.bound * rng.uniform(-1.0, 1.0, size=shape)
+        if self.std.any():
+            out += self.std * rng.standard_normal(shape)
+        return out
 
 
 def _close(name: str, known) -> str:
@@ -258,6 +252,7 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
         return d
     table, t = np.tile(d, (N + 1, 1)), step * np.arange(N + 1)
     for fields in items:
+        fields.describe("signal", "string", "one of the plant's disturbances")
         signal = fields.text("signal", choices=plant.d.names)
         times = fields.vector("times", len(fields.data.get("times") or []))
         values = fields.vector("values", times.size if times is not None else 0)
@@ -443,18 +438,21 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     d = _point(initial, "d", plant.d, np.zeros(plant.d.size))
     initial.done()
     d = _disturbances(top.tables("disturbances"), plant, d, round(duration / step), step)
-    random_disturbance = _random_disturbance(top.table("disturbance"), plant, seed)
+    disturbance_seed = top.raw("disturbance_seed", None, "integer", ">= 0: the draws of [noise]'s disturbances",
+                               "the stream (seed, 1)")
+    if disturbance_seed is not None:
+        disturbance_seed = top.integer("disturbance_seed", unit="disturbance draws")
     noise_fields = top.table("noise")
     top.describe("noise.<output>", "number or table", "standard deviation of the output's Gaussian sensor noise, "
                  "or { uniform = bound } (its unit)", "none")
-    top.describe("noise.<disturbance>", "number", "standard deviation of a white disturbance, held over each "
-                 "sample (its unit)", "none")
-    noise, d_noise = {}, np.zeros(plant.d.size)
+    top.describe("noise.<disturbance>", "number or table", "standard deviation of a white Gaussian disturbance, "
+                 "or { uniform = bound }, drawn every sample and held over it (its unit)", "none")
+    noise, spread = {}, {"noise": np.zeros(plant.d.size), "uniform_noise": np.zeros(plant.d.size)}
     if noise_fields is not None:
         for channel in list(noise_fields.data):
             if channel in plant.d.names:
-                d_noise[plant.d.index(channel)] = Fields(noise_fields.data, noise_fields.path).number(
-                    channel, positive=True)
+                kind, value = _noise(Fields(noise_fields.data, noise_fields.path), channel)
+                spread[kind][plant.d.index(channel)] = value
                 noise_fields.used.add(channel)
                 continue
             if channel not in plant.y.names:
@@ -501,8 +499,10 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     return SystemScenario(name=name, description=description, plant=plant, duration=duration, step=step, seed=seed,
                           loop=loop, z0=z0, d=d, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                           supervisor=FlagSubstitution(tuple(flags), step) if flags else None,
-                          detectors=tuple(detectors), substitutions=by, d_noise=d_noise if d_noise.any() else None,
-                          random_disturbance=random_disturbance)
+                          detectors=tuple(detectors), substitutions=by, disturbance_noise=DisturbanceNoise(
+                              spread["noise"], spread["uniform_noise"],
+                              (seed, 1) if disturbance_seed is None else disturbance_seed)
+                          if any(v.any() for v in spread.values()) else None)
 
 
 
@@ -525,14 +525,8 @@ def scenario_inputs(scenario: SystemScenario) -> np.ndarray:
     """W (N + 1, n_w) of the scenario's run (:func:`~uvsym.sim.system_simulation.loop_inputs`): its
     disturbances (constant or scheduled) plus its white disturbance noise, its seeded sensor-noise
     draws and its faults' numbers."""
-    from uvsym.sim.loop import disturbance_draws
-
     N = round(scenario.duration / scenario.step)
-    d = scenario.d
-    if scenario.d_noise is not None:
-        d = d + scenario.d_noise * disturbance_draws(N, scenario.plant.d.size, scenario.seed)
-    if scenario.random_disturbance is not None:
-        d = d + scenario.random_disturbance.draws(N)
+    d = scenario.d if scenario.disturbance_noise is None else scenario.d + scenario.disturbance_noise.draws(N)
     return loop_inputs(scenario.loop, N, d, scenario.seed)
 
 
