@@ -5,8 +5,8 @@
 
 int main(void) {
   int i, rc;
-  static const uvsym_induction_motor_real s[5] = {0.011768947693313048, 30.07036774194383, 0.00045413349830115957, 0.2780464282429195,
-    250.00121722951698};
+  static const uvsym_induction_motor_real s[5] = {0.011768942830484963, 30.07036774334313, 0.0004541335020886907, 0.2780464283442053,
+    250.00121722927477};
   static const uvsym_induction_motor_real y[3] = {0.008484252354150196, 29.94674925715017, 249.99996234140758};
   static const uvsym_induction_motor_real u[2] = {143.23944878999998, 0.8999999999999999};
   const uvsym_induction_motor_real* p = NULL;
