@@ -156,6 +156,17 @@ seed = {seed}
     assert [run.draw for run in first.runs[:4]] == [0, 1, 2, 0]
 
 
+def test_monte_carlo_draws_the_scenarios_own_seed_when_seed_is_a_distribution(tmp_path):
+    """seed = an integer seeds the draws; seed = {integers = ...} draws the scenario's noise seed itself."""
+    draws = ('[case.monte_carlo]\nruns = 4\nseed = { integers = [100, 999] }\n'
+             '"current.speed" = { uniform = [0.0, 0.2] }\n')
+    campaign = load_campaign(_write(tmp_path, GRID + draws))
+    seeds = [run.scenario["seed"] for run in campaign.runs]
+    assert all(isinstance(s, int) and 100 <= s <= 999 for s in seeds) and len(set(seeds)) > 1
+    again = load_campaign(_write(tmp_path, GRID + draws, "again.toml"))
+    assert [r.scenario["seed"] for r in again.runs] == seeds            # from the master seed 0: reproducible
+
+
 def test_the_example_campaign_is_valid(capsys):
     from pathlib import Path
 

@@ -140,7 +140,8 @@ def _bad(edit) -> str:
     (lambda t: t["blocks"][0].update(turn_radius=200.0), r"blocks\[0\]\.turn_radius: 200(\.0)? m is too large"),
     (lambda t: t["blocks"][0]["heading_loop"].update(kq=1.0), r"blocks\[0\]\.heading_loop\.kq: unknown field"),
     (lambda t: t["blocks"][0].pop("speed_loop"), r"blocks\[0\]\.speed_loop: required table"),
-    (lambda t: t["noise"].update(tau_x={"uniform": 1.0}), r"noise\.tau_x: unknown output or disturbance .*disturbances: tau_u, tau_v, tau_r"),
+    (lambda t: t["noise"].update(tau_x={"uniform": 1.0}),
+     r"noise\.tau_x: unknown output or disturbance .*tau_u, tau_v, tau_r"),
     (lambda t: t["noise"].update(tau_u={"uniform": -1.0}), r"noise\.tau_u\.uniform: must be positive"),
     (lambda t: t["noise"].update(tau_u={"unifrom": 1.0}), r"noise\.tau_u\.unifrom: unknown field"),
     (lambda t: t["detectors"][0].update(bank="ukff"), r"detectors\[0\]\.bank: 'ukff' is not an mmae block of the "

@@ -10,9 +10,10 @@ chunk_size, timeout_s: how long to wait for a Dask scheduler to answer, not a li
 :func:`~uvsym.sim.simulation.simulate_scenario`) and one or more ``[[case]]`` tables: ``name``,
 ``scenario`` (a shipped scenario or a path relative to the campaign file), ``set`` (dotted path ->
 value, every run of the case), ``[case.grid]`` (dotted path -> list of values, full product, in
-file order) and ``[case.monte_carlo]`` (``runs`` draws per grid point from the master ``seed``;
-dotted path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}``
-(both ends included) or ``{choice = [...]}``). Paths follow :mod:`uvsym.campaign.dotted`.
+file order) and ``[case.monte_carlo]`` (``runs`` draws per grid point from the master ``seed``, an
+integer; dotted path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}``
+(both ends included) or ``{choice = [...]}``; ``seed = {integers = [lo, hi]}`` draws the scenario's
+own noise seed, the master seed then 0). Paths follow :mod:`uvsym.campaign.dotted`.
 
 A case's scenario is a vehicle scenario or a scenario over any plant (``plant = ...``,
 :mod:`uvsym.sim.system_scenario`); every run's scenario is parsed when the campaign is loaded, so a
@@ -244,7 +245,8 @@ def _monte_carlo(table, where: str):
     if not isinstance(table, dict):
         raise CampaignError(f"{where}: monte_carlo: expected a table")
     table = dict(table)
-    runs, seed = table.pop("runs", None), table.pop("seed", 0)
+    # seed = an integer is the draws' master seed; seed = a distribution draws the scenario's own seed
+    runs, seed = table.pop("runs", None), 0 if isinstance(table.get("seed"), dict) else table.pop("seed", 0)
     for key, value, minimum in (("runs", runs, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
             raise CampaignError(f"{where}: monte_carlo.{key}: expected an integer >= {minimum}, got {value!r}")
