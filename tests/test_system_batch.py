@@ -74,6 +74,23 @@ def test_lanes_equal_the_scalar_path_for_every_variant():
         assert lane.meta["sensor_faults"] == scalar.meta["sensor_faults"]
 
 
+def test_a_loop_with_a_ukf_runs_in_lanes_equal_to_the_scalar_path():
+    """The UKF's step uses |x| (CasADi's casadi_fabs): the lanes run it too, not the scalar fallback."""
+    table = tomllib.loads((EXAMPLE / "speed_sensor_bias.toml").read_text()) | {"duration": 2.0}
+    scenarios = [parse_system_scenario(table | {"seed": k, "faults": [BIAS | {"value": 1.0 + k, "onset": 1.0}]},
+                                       root=EXAMPLE) for k in range(3)]
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                      # no fallback to one run after another
+        batched = simulate_batch(scenarios, lanes=4)
+    for scenario, lane in zip(scenarios, batched):
+        scalar = simulate_system_scenario(scenario)
+        for name in ("ukf", "luenberger", "x"):
+            np.testing.assert_allclose(lane[name].values, scalar[name].values, rtol=1e-9, atol=1e-9, err_msg=name)
+        assert [(e["event"], e["t"]) for e in lane.events] == [(e["event"], e["t"]) for e in scalar.events]
+
+
 def test_a_flag_substitution_cannot_run_in_lanes_and_nothing_else_is_taken():
     table = tomllib.loads((EXAMPLE / "speed_sensor_bias.toml").read_text()) | {"duration": 4.0, "faults": []}
     table["setpoints"] = table["setpoints"] + [{"signal": "sw", "times": [0.0, 3.0], "values": [0.0, 1.0]}]

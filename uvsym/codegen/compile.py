@@ -207,6 +207,7 @@ static inline double casadi_sq(double x) { return x * x; }
 static inline double casadi_fmin(double x, double y) { return (y != y || x < y) ? x : y; }
 static inline double casadi_fmax(double x, double y) { return (y != y || x > y) ? x : y; }
 static inline double casadi_sign(double x) { return x < 0 ? -1. : x > 0 ? 1. : x; }
+static inline double casadi_fabs(double x) { return fabs(x); }
 """
 _LANES = """
 static void {name}_lanes_step(const double* restrict in0, const double* restrict in1, double* restrict out0,
@@ -238,7 +239,7 @@ def _lane_body(step: ca.Function) -> str:
     body = re.sub(r"arg\[([01])\]\? arg\[\1\]\[(\d+)\] : 0", r"in\1[\2 * L + l]", bodies[0])
     body = re.sub(r"if \(res\[([01])\]!=0\) res\[\1\]\[(\d+)\]=", r"out\1[\2 * L + l]=", body)
     calls = set(re.findall(r"([A-Za-z_]\w*)\(", body)) - set(_VECTOR_MATH) - _SCALAR_OK
-    calls -= {"casadi_sq", "casadi_fmin", "casadi_fmax", "casadi_sign"}
+    calls -= {"casadi_sq", "casadi_fmin", "casadi_fmax", "casadi_sign", "casadi_fabs"}
     if calls or re.search(r"\b(arg|res|iw|w|for|while)\b", body):
         raise CodegenError(f"{step.name()}: its generated code is not straight-line scalar code the lanes can run "
                            f"(calls {sorted(calls)})")
