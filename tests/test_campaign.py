@@ -165,6 +165,11 @@ def test_monte_carlo_draws_the_scenarios_own_seed_when_seed_is_a_distribution(tm
     assert all(isinstance(s, int) and 100 <= s <= 999 for s in seeds) and len(set(seeds)) > 1
     again = load_campaign(_write(tmp_path, GRID + draws, "again.toml"))
     assert [r.scenario["seed"] for r in again.runs] == seeds            # from the master seed 0: reproducible
+    other = load_campaign(_write(tmp_path, GRID + draws + "master_seed = 7\n", "other.toml"))
+    assert [r.scenario["seed"] for r in other.runs] != seeds            # master_seed beside it seeds the draws
+    with pytest.raises(CampaignError, match="give the master seed as seed or as master_seed, not both"):
+        load_campaign(_write(tmp_path, GRID + '[case.monte_carlo]\nruns = 2\nseed = 1\nmaster_seed = 2\n'
+                             '"current.speed" = { uniform = [0.0, 0.2] }\n', "both.toml"))
 
 
 def test_the_example_campaign_is_valid(capsys):

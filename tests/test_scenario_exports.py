@@ -52,7 +52,8 @@ def test_the_example_states_are_the_blocks_own_run_in_the_loop():
 
 def test_a_block_selection_names_an_unknown_block_with_the_known_ones(tmp_path, capsys):
     assert main(["codegen", str(SCENARIO), "-o", str(tmp_path / "c"), "--blocks", "luenberg"]) == 2
-    assert ("blocks: dc_motor_speed_sensor_bias has no block 'luenberg'; its blocks: speed, luenberger, ukf"
+    assert ("blocks: dc_motor_speed_sensor_bias has no block 'luenberg' (did you mean 'luenberger'?); its blocks: "
+            "speed, luenberger, ukf"
             in capsys.readouterr().err)
     assert not (tmp_path / "c").exists()
 

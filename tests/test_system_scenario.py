@@ -151,7 +151,7 @@ def test_bad_blocks_and_detectors_are_named():
     table = _table()
     table["detectors"][0]["residuals"] = ["luenberger.r_omega"]
     del table["detectors"][0]["targets"]
-    with pytest.raises(ScenarioError, match=r"detectors\[0\].*'luenberger.r_omega' is not logged"):
+    with pytest.raises(ScenarioError, match=r"detectors\[0\]\.residuals: no logged signal 'luenberger.r_omega'; did"):
         _parse(table)
     table = _table()
     table["detectors"][0] = {"type": "lms", "name": "x", "monitor": "luenberger"}
@@ -250,3 +250,42 @@ def test_a_campaign_substeps_option_is_refused_for_plant_scenarios(tmp_path):
         load_campaign(path)
     path.write_text(f'name = "dc"\n[[case]]\nname = "a"\nscenario = "{SCENARIO}"\nset = {{ substeps = 4 }}\n')
     assert load_campaign(path).runs[0].scenario["substeps"] == 4
+
+
+def test_a_latched_detector_keeps_its_detection_while_the_observer_absorbs_the_bias():
+    """The Luenberger observer follows the +2 rad/s speed bias, so its residual comes back inside and
+    the default rule clears while the fault persists; latch = true keeps the detection to the end."""
+    events = simulate_system_scenario(_parse(_table())).events
+    own = [e["event"] for e in events if e["detector"] == "luenberger_fd"]
+    assert own == ["detected", "cleared"]
+    table = _table()
+    for d in table["detectors"]:
+        d["latch"] = True
+    latched = simulate_system_scenario(_parse(table)).events
+    assert [e["event"] for e in latched if e["detector"] == "luenberger_fd"] == ["detected"]
+    table["detectors"][0]["latch"] = "yes"
+    with pytest.raises(ScenarioError, match=r"detectors\[0\]\.latch: expected true or false, got 'yes'"):
+        _parse(table)
+
+
+def test_a_detector_reads_a_bare_residual_name_that_one_block_logs_and_names_the_choices_otherwise():
+    table = _table()
+    table["detectors"][0]["residuals"] = ["r_i_meas", "r_omega_meas"]
+    with pytest.raises(ScenarioError, match=r"detectors\[0\]\.residuals: 'r_i_meas' is logged by several groups: "
+                                            r"name one of luenberger\.r_i_meas, ukf\.r_i_meas"):
+        _parse(table)
+    table["blocks"] = [b for b in table["blocks"] if b["type"] != "ukf"]
+    table["detectors"] = table["detectors"][:1]
+    assert _parse(table).detectors[0].residuals == ("luenberger.r_i_meas", "luenberger.r_omega_meas")
+    table["detectors"][0]["residuals"] = ["luenberger.r_i_mes", "r_omega_meas"]
+    with pytest.raises(ScenarioError, match=r"no logged signal 'luenberger\.r_i_mes'; did you mean "
+                                            r"'luenberger\.r_i_meas'"):
+        _parse(table)
+
+
+def test_a_misspelt_block_type_gets_its_close_match():
+    table = _table()
+    table["blocks"][1]["type"] = "luenbergr"
+    with pytest.raises(ScenarioError, match=r"blocks\[1\]\.type: unknown value 'luenbergr' \(did you mean "
+                                            r"'luenberger'\?\); known: pid"):
+        _parse(table)

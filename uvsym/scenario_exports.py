@@ -15,6 +15,8 @@ estimator of which nothing can be claimed (a UKF's state holds its covariance) i
 
 from __future__ import annotations
 
+import difflib
+
 import numpy as np
 
 from uvsym.codegen.arguments import entries_of
@@ -35,7 +37,9 @@ def scenario_blocks(scenario, names=None) -> list:
     known = {b.name: b for b in blocks}
     unknown = [n for n in names if n not in known]
     if unknown:
-        raise ScenarioError(f"blocks: {scenario.name} has no block {unknown[0]!r}; its blocks: {', '.join(known)}")
+        near = difflib.get_close_matches(unknown[0], list(known), n=1)
+        raise ScenarioError(f"blocks: {scenario.name} has no block {unknown[0]!r}"
+                            + (f" (did you mean {near[0]!r}?)" if near else "") + f"; its blocks: {', '.join(known)}")
     return [known[n] for n in names]
 
 

@@ -13,7 +13,8 @@ value, every run of the case), ``[case.grid]`` (dotted path -> list of values, f
 file order) and ``[case.monte_carlo]`` (``runs`` draws per grid point from the master ``seed``, an
 integer; dotted path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}``
 (both ends included) or ``{choice = [...]}``; ``seed = {integers = [lo, hi]}`` draws the scenario's
-own noise seed, the master seed then 0). Paths follow :mod:`uvsym.campaign.dotted`.
+own noise seed, the master seed then ``master_seed``, default 0). Paths follow
+:mod:`uvsym.campaign.dotted`.
 
 A case's scenario is a vehicle scenario or a scenario over any plant (``plant = ...``,
 :mod:`uvsym.sim.system_scenario`); every run's scenario is parsed when the campaign is loaded, so a
@@ -245,8 +246,15 @@ def _monte_carlo(table, where: str):
     if not isinstance(table, dict):
         raise CampaignError(f"{where}: monte_carlo: expected a table")
     table = dict(table)
-    # seed = an integer is the draws' master seed; seed = a distribution draws the scenario's own seed
-    runs, seed = table.pop("runs", None), 0 if isinstance(table.get("seed"), dict) else table.pop("seed", 0)
+    # seed = an integer is the draws' master seed (or master_seed, beside seed = a distribution, which
+    # draws the scenario's own noise seed: TOML holds one key seed per table)
+    master, runs = table.pop("master_seed", None), table.pop("runs", None)
+    if isinstance(table.get("seed"), dict):
+        seed = 0 if master is None else master
+    elif master is not None and "seed" in table:
+        raise CampaignError(f"{where}: monte_carlo: give the master seed as seed or as master_seed, not both")
+    else:
+        seed = table.pop("seed", 0 if master is None else master)
     for key, value, minimum in (("runs", runs, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
             raise CampaignError(f"{where}: monte_carlo.{key}: expected an integer >= {minimum}, got {value!r}")

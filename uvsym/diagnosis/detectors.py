@@ -15,7 +15,11 @@ of the residual with the largest ``|r_i| / c_i`` there (a hint); ``isolated`` on
 only with ``isolate`` set, which claims that the residuals are structured (each one responds to
 its target's fault alone): an observer's output residuals are not (an actuator fault moves them
 as a sensor fault does), so by default the detector detects and does not isolate. ``cleared``
-once ``release`` samples in a row do not (hysteresis: no alarm stays latched after its evidence is gone). Samples before
+once ``release`` samples in a row do not (hysteresis: no alarm stays latched after its evidence is
+gone). ``cleared`` says the residuals are back inside their thresholds, not that the fault is gone:
+an estimator whose model follows a constant bias (an observer's state absorbs a sensor offset)
+brings its residual back while the fault persists; ``latch`` keeps every detection to the end of
+the run instead (no ``cleared``, at most one alarm per run). Samples before
 ``ignore_before`` s (the estimator's start-up) are not judged. ``given`` thresholds (the residuals'
 units, e.g. a study's own calibration on fault-free runs) replace ``z sigma``; sigma is then
 reported beside them.
@@ -69,7 +73,8 @@ class ResidualThreshold:
     """Threshold test on residuals (module docstring). residuals: m signal names; sigma: (m,) their
     standard deviations (residuals' units); isolate: the residuals are structured (module
     docstring); targets: the signal each residual points to (an input
-    or output of the plant) or None; dt: sample period (s)."""
+    or output of the plant) or None; dt: sample period (s); latch: a detection stands to the end
+    of the run (no ``cleared``)."""
 
     name: str
     residuals: tuple[str, ...]
@@ -82,6 +87,7 @@ class ResidualThreshold:
     targets: tuple[str | None, ...] = ()
     isolate: bool = False
     given: tuple[float, ...] = ()
+    latch: bool = False
     thresholds: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -122,7 +128,7 @@ class ResidualThreshold:
             if self.isolate and target is not None:
                 events.append(Event(time, "isolated", target, detector=self.name))
             j = np.searchsorted(released, k, side="right")
-            if j == released.size:
+            if self.latch or j == released.size:
                 break
             k = int(released[j])  # the first release after it: cleared
             events.append(Event(round(float(t[k]), 9), "cleared", detector=self.name))
@@ -135,7 +141,7 @@ class ResidualThreshold:
                 "sigma": self.sigma.tolist(), "thresholds": self.thresholds.tolist(),
                 "false_alarms_per_hour": self.false_alarms_per_hour,
                 "per_sample_probability": self.false_alarms_per_hour * self.dt / 3600.0,
-                "confirm_samples": self.confirm, "release_samples": self.release}
+                "confirm_samples": self.confirm, "release_samples": self.release, "latch": self.latch}
 
 
 @dataclass(frozen=True)

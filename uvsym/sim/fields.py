@@ -89,7 +89,9 @@ class Fields:
             missing = self._misspelt(key) if value is None else ""
             raise ScenarioError(f"{self._name(key)}: expected a string, got {value!r}{missing}")
         if choices is not None and value not in choices:
-            raise ScenarioError(f"{self._name(key)}: unknown value {value!r}; known: {', '.join(choices)}")
+            near = difflib.get_close_matches(value, list(choices), n=1)
+            raise ScenarioError(f"{self._name(key)}: unknown value {value!r}"
+                                + (f" (did you mean {near[0]!r}?)" if near else "") + f"; known: {', '.join(choices)}")
         return value
 
     def vector(self, key: str, size: int, default=None) -> np.ndarray | None:

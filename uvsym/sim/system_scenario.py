@@ -30,7 +30,9 @@ switches in the same sample) and ``[[detectors]]``:
   ``thresholds`` (given, in the residuals' units, instead of designed: a calibration of one's own),
   ``std`` (the residuals' standard deviations; default computed from ``[noise]`` through the loop
   linearised at the plant's operating point, :mod:`uvsym.diagnosis.calibration`), ``confirm`` and
-  ``release`` (samples), ``ignore_before`` (s);
+  ``release`` (samples), ``latch`` (a detection stands to the end: ``cleared`` only says the
+  residuals are back inside, which an observer absorbing a constant bias gives while the fault
+  persists), ``ignore_before`` (s);
 - ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions, and a
   StepSizeWarning when the block's mu is at or beyond the mean-square bound of the run's input power;
 - ``type = "zonotope_bands"``: ``bank`` (a uio_bank block's name), ``noise_bound`` and
@@ -320,12 +322,30 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
                            order)
 
 
+def _logged(name: str, scenario_loop: WiredLoop, where: str) -> str:
+    """The logged signal ``<group>.<label>`` a detector's ``name`` reads: qualified as given, or a bare
+    label that one group logs (ScenarioError naming the qualified choices when several do, and the
+    close matches when none does)."""
+    logged = [f"{g}.{label}" for g, entry in scenario_loop.signals.items()
+              if g not in ("fault_sensor", "fault_actuator") for label in entry[1]]
+    if name in logged:
+        return name
+    choices = [q for q in logged if q.split(".", 1)[1] == name] if "." not in name else []
+    if len(choices) == 1:
+        return choices[0]
+    if choices:
+        raise ScenarioError(f"{where}: {name!r} is logged by several groups: name one of {', '.join(choices)}")
+    near = difflib.get_close_matches(name, logged, n=3)
+    raise ScenarioError(f"{where}: no logged signal {name!r}" + (f"; did you mean {' or '.join(map(repr, near))}?"
+                                                                 if near else f"; logged: {', '.join(logged)}"))
+
+
 def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
                         step: float) -> ResidualThreshold:
     """``type = "threshold"``: residual thresholds designed for a false-alarm rate (module docstring)."""
     from uvsym.diagnosis.calibration import residual_covariance
 
-    residuals = _names(fields, "residuals")
+    residuals = tuple(_logged(name, scenario_loop, f"{fields.path}.residuals") for name in _names(fields, "residuals"))
     targets = fields.raw("targets", None, "list of strings", "the plant input or output each residual points to",
                          "none")
     known = scenario_loop.plant.u.names + scenario_loop.plant.y.names
@@ -344,6 +364,9 @@ def _threshold_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0:
                             f"{options['isolate']!r}")
     for key, default in (("confirm", 3), ("release", 20)):
         options[key] = fields.integer(key, default, minimum=1, unit="samples")
+    options["latch"] = fields.raw("latch", False, "boolean", "a detection stands to the end of the run (no cleared)")
+    if not isinstance(options["latch"], bool):
+        raise ScenarioError(f"{fields.path}.latch: expected true or false, got {options['latch']!r}")
     fields.done()
     if std is None:
         std = np.sqrt(np.diag(residual_covariance(scenario_loop, z0, w0, residuals)))
