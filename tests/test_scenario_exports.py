@@ -99,3 +99,17 @@ def test_a_shipped_scenario_is_exported_and_verified_by_its_name(tmp_path, capsy
     assert "observer on rov_yaw: linearised error decays at rate 1 1/s" in capsys.readouterr().out
     assert main(["codegen", "rov_yaw_compass_bias", "-o", str(tmp_path / "c")]) == 0
     assert (tmp_path / "c" / "src" / "rov_yaw_compass_bias.c").exists()
+
+
+def test_the_package_is_written_again_over_its_own_make_products_but_not_over_a_users_file(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert main(["codegen", "rov_yaw_compass_bias", "-o", str(out)]) == 0
+    from uvsym.codegen.build_files import make_products
+
+    for product in make_products("rov_yaw_compass_bias"):      # as `make` leaves them
+        (out / product).write_bytes(b"built")
+    assert main(["codegen", "rov_yaw_compass_bias", "-o", str(out)]) == 0
+    (out / "notes.txt").write_text("mine")
+    assert main(["codegen", "rov_yaw_compass_bias", "-o", str(out)]) == 2
+    assert "holds files uvsym did not write (notes.txt)" in capsys.readouterr().err
+    assert (out / "notes.txt").read_text() == "mine"

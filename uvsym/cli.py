@@ -295,7 +295,10 @@ def _cmd_codegen(args) -> int:
         options = {key: value for key, value in (("vehicle", args.vehicle), ("form", args.form)) if value is not None}
         options |= _set_options(args.name, factory, args.set_options)
         observers = observer_set(args.name, **options)
-    make_folder(claim_folder(args.out, "the C package", "package", args.force), "the C package")
+    from uvsym.codegen.build_files import make_products
+
+    make_folder(claim_folder(args.out, "the C package", "package", args.force,
+                             built=make_products(observers.package_name)), "the C package")
     manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check)
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "

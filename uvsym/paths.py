@@ -110,10 +110,11 @@ def _listing(names: list[str]) -> str:
     return ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
 
 
-def claim_folder(path, what: str, owner: str, force: bool = False) -> Path:
+def claim_folder(path, what: str, owner: str, force: bool = False, built: tuple[str, ...] = ()) -> Path:
     """The folder ``path`` for ``what`` (not made here); PathError naming the files when it holds
     files that are not uvsym's own ``owner`` output, or that changed since uvsym wrote them (module
-    docstring), unless ``force``, or is not a writable folder."""
+    docstring), unless ``force``, or is not a writable folder. ``built``: relative paths that the
+    output's own build files write (a C package's ``make`` products), taken as uvsym's."""
     folder = output_folder(path, what, PathError)
     if not folder.is_dir() or force:
         return folder
@@ -123,7 +124,7 @@ def claim_folder(path, what: str, owner: str, force: bool = False) -> Path:
         changed = []
     else:
         present = file_hashes(folder, skip=RECORDS[owner])
-        others = [rel for rel in present if rel not in files]
+        others = [rel for rel in present if rel not in files and rel not in built]
         changed = [rel for rel, digest in present.items() if rel in files and files[rel] != digest]
     problems = ([f"files uvsym did not write ({_listing(others)})"] if others else []) + (
         [f"files changed since uvsym wrote them ({_listing(changed)})"] if changed else [])

@@ -14,8 +14,16 @@ __all__ = ["WARNINGS", "cmake_lists", "makefile"]
 WARNINGS = ("-Wall", "-Wextra", "-pedantic")
 
 
+def make_products(name: str) -> tuple[str, ...]:
+    """The files ``make`` writes in package ``name``'s folder (what ``make clean`` removes): uvsym's own
+    output too, so that writing the package again over a built one is not refused."""
+    return (f"src/{name}_casadi.o", f"src/{name}.o", "main.o", "harness.o", f"lib{name}.a", f"lib{name}.so",
+            "example", "harness")
+
+
 def makefile(name: str) -> str:
     """The package's Makefile (``make``; ``make CFLAGS=...`` to change flags)."""
+    products = make_products(name)
     return f"""# Builds lib{name}.a, lib{name}.so, the example and the harness.
 # CFLAGS may be overridden freely (e.g. make CFLAGS="-std=c99 -O2 {' '.join(WARNINGS)} -Werror -fPIC");
 # include paths live in CPPFLAGS.
@@ -23,7 +31,7 @@ CC ?= cc
 CFLAGS ?= -std=c99 -O2 {' '.join(WARNINGS)} -fPIC
 CPPFLAGS += -Iinclude
 LDLIBS += -lm
-OBJ = src/{name}_casadi.o src/{name}.o
+OBJ = {' '.join(products[:2])}
 
 all: lib{name}.a lib{name}.so example harness
 
