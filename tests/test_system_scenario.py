@@ -289,3 +289,14 @@ def test_a_misspelt_block_type_gets_its_close_match():
     with pytest.raises(ScenarioError, match=r"blocks\[1\]\.type: unknown value 'luenbergr' \(did you mean "
                                             r"'luenberger'\?\); known: pid"):
         _parse(table)
+
+
+def test_the_quick_look_figure_marks_the_fault_onset_and_the_alarms(shipped):
+    _, result = shipped
+    fig = result.plot()
+    first = fig.axes[0]
+    marks = {line.get_label(): line.get_xdata()[0] for line in first.lines if line.get_label() in ("fault onset",
+                                                                                                  "alarm")}
+    assert marks["fault onset"] == 3.0                       # the bias, not the whole-run sensor noise
+    assert 3.0 <= marks["alarm"] <= 3.05                     # the first detection
+    assert all(any(line.get_linestyle() == "--" for line in ax.lines) for ax in fig.axes)

@@ -157,7 +157,9 @@ class SimResult:
         (checked by :meth:`check_plot_path`: an existing file is kept unless ``overwrite``).
 
         Default signals: states, commands and fault estimates of a scenario run; states, inputs
-        and every block's published signals of a wired loop."""
+        and every block's published signals of a wired loop. Every panel marks the faults' onsets
+        (dashed red; whole-run sensor noise is not a fault) and the detectors' alarms (detected,
+        isolated or identified: dotted black), from the result's meta and decision log."""
         if path is not None:
             path = self.check_plot_path(path, overwrite)
         import matplotlib
@@ -179,9 +181,18 @@ class SimResult:
                 groups.setdefault(shown, []).append((label, scale * column))
             panels += [(f"{name} ({unit})", lines) for unit, lines in groups.items()]
         fig, axes = plt.subplots(len(panels), 1, figsize=(9, 1.9 * len(panels)), sharex=True, squeeze=False)
+        from uvsym.diagnosis.events import ALARMS  # here: the diagnosis package builds on uvsym.sim
+
+        onsets = sorted({f["onset_s"] for kind in ("actuator_faults", "sensor_faults")
+                         for f in self.meta.get(kind, ()) if not f.get("kind", "").endswith("noise")})
+        alarms = sorted({e["t"] for e in (self.meta.get("events") or ()) if e["event"] in ALARMS})
         for ax, (title, lines) in zip(axes[:, 0], panels):
             for label, column in lines:
                 ax.plot(self.t, column, label=label, lw=1)
+            for times, style, what in ((onsets, dict(color="tab:red", ls="--"), "fault onset"),
+                                       (alarms, dict(color="black", ls=":"), "alarm")):
+                for i, when in enumerate(times):
+                    ax.axvline(when, lw=0.8, label=what if i == 0 and ax is axes[0, 0] else None, **style)
             ax.set_title(title, fontsize=9, loc="left")
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, ncol=min(len(lines), 6), loc="upper right")
