@@ -248,7 +248,7 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
 def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, step: float) -> np.ndarray:
     """The [[disturbances]] schedules (module docstring) over the samples ``k step``, k = 0..N: (N + 1,
     n_d) with the other disturbances at their constants d (n_d,); d itself without schedules."""
-    from uvsym.sim.feedback import INTERPOLATIONS
+    from uvsym.sim.feedback import INTERPOLATIONS, open_loop
 
     if not items:
         return d
@@ -262,11 +262,8 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
         fields.done()
         if times is None or not times.size or np.any(np.diff(times) <= 0):
             raise ScenarioError(f"{fields.path}.times: expected strictly increasing times (s), one per value")
-        column = table[:, plant.d.index(signal)]
-        if how == "linear":
-            column[:] = np.interp(t, times, values)
-        else:  # the value of the last time at or before the sample (within 1e-9 s), the first before t_0
-            column[:] = values[np.maximum(np.searchsorted(times, t + 1e-9, side="right") - 1, 0)]
+        schedule_step = open_loop(f"disturbance_{signal}", times, values, (signal,), how).step  # a set-point's rule
+        table[:, plant.d.index(signal)] = np.asarray(schedule_step.map(N + 1)(np.zeros((0, N + 1)), t[None, :])[1])
     return table
 
 
@@ -390,12 +387,10 @@ def _hybrid_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np
                      step: float) -> EstimatedFault:
     """``type = "hybrid"``: a threshold test (the fields of ``threshold``) that detects, and the hybrid
     observer's fault estimate that identifies (:class:`~uvsym.diagnosis.detectors.EstimatedFault`)."""
-    estimate = _names(fields, "estimate", size=1)[0]
-    logged = [f"{g}.{label}" for g, entry in scenario_loop.signals.items() if g not in ("x", "u", "y")
-              for label in entry[1]]
-    if estimate not in logged:
+    estimate = _logged(_names(fields, "estimate", size=1)[0], scenario_loop, f"{fields.path}.estimate")
+    if estimate.partition(".")[0] in ("x", "u", "y"):
         raise ScenarioError(f"{fields.path}.estimate: {estimate!r} is not a block's published signal "
-                            f"(<block>.<signal>){_close(estimate, logged)}")
+                            "(<block>.<signal>)")
     options = {"gain": fields.number("estimate_gain", 1.0),
                "identify_after": fields.number("identify_after", 0.5, minimum=0.0),
                "average": fields.number("average", 0.1, minimum=0.0)}
