@@ -44,7 +44,8 @@ import numpy as np
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError
 
-__all__ = ["ResidualThreshold", "DoubleCriterion", "EstimatedFault", "threshold_factor", "read_signal"]
+__all__ = ["ResidualThreshold", "DoubleCriterion", "EstimatedFault", "check_samples", "threshold_factor",
+           "read_signal"]
 
 
 def read_signal(result, name: str) -> np.ndarray:
@@ -54,6 +55,14 @@ def read_signal(result, name: str) -> np.ndarray:
         known = [f"{g}.{lab}" for g, s in result.signals.items() for lab in s.labels]
         raise DiagnosisError(f"signal {name!r} is not in the result; logged: {', '.join(known)}")
     return np.asarray(result[group][label], dtype=float)
+
+
+def check_samples(detector, *fields: str) -> None:
+    """DiagnosisError naming the first of the detector's ``fields`` that is not an integer >= 1 (samples)."""
+    for what in fields:
+        value = getattr(detector, what)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise DiagnosisError(f"detector {detector.name}: {what} must be an integer >= 1 (samples), got {value!r}")
 
 
 def threshold_factor(false_alarms_per_hour: float, dt: float, channels: int) -> float:
@@ -95,10 +104,7 @@ class ResidualThreshold:
         if sigma.shape != (len(self.residuals),) or not np.all(np.isfinite(sigma)) or np.any(sigma <= 0):
             raise DiagnosisError(f"detector {self.name}: sigma must be {len(self.residuals)} positive finite standard "
                                  f"deviations (one per residual), got {sigma.tolist()}")
-        for what in ("confirm", "release"):
-            value = getattr(self, what)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise DiagnosisError(f"detector {self.name}: {what} must be an integer >= 1 (samples), got {value!r}")
+        check_samples(self, "confirm", "release")
         targets = self.targets or (None,) * len(self.residuals)
         if len(targets) != len(self.residuals):
             raise DiagnosisError(f"detector {self.name}: {len(targets)} targets for {len(self.residuals)} residuals")

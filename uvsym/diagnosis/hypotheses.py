@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uvsym.diagnosis.detectors import read_signal
+from uvsym.diagnosis.detectors import check_samples, read_signal
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError, ScenarioError
 from uvsym.faults import ACTUATOR_KINDS
@@ -58,10 +58,7 @@ class HypothesisSwitch:
         if not 0.5 <= self.threshold < 1.0:
             raise DiagnosisError(f"detector {self.name}: threshold must be in [0.5, 1) (a probability that "
                                  f"only one hypothesis can exceed), got {self.threshold!r}")
-        for what in ("dwell", "settle"):
-            value = getattr(self, what)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise DiagnosisError(f"detector {self.name}: {what} must be an integer >= 1 (samples), got {value!r}")
+        check_samples(self, "dwell", "settle")
 
     def decide(self, result) -> list[Event]:
         t = np.asarray(result.t, dtype=float)
