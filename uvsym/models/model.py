@@ -111,7 +111,8 @@ class Model:
 
     def as_system(self) -> System:
         """This vehicle as a :class:`~uvsym.systems.System`: ``x = [eta; nu]``, ``u`` the actuator
-        inputs, no disturbance, ``p = (V_c, beta_c)`` the current (nominal 0), ``y = x``."""
+        inputs (delivered at once: no actuator lag), no disturbance, ``p = (V_c, beta_c)`` the current
+        (nominal 0), ``y = x``; ``extras["vehicle"]`` is this Model."""
         x = Signals(self.state_labels, self.state_units, group="state")
         u = Signals(self.input_labels, self.input_units, group="input")
         p = Signals(("V_c", "beta_c"), ("m/s", "rad"),
@@ -122,7 +123,8 @@ class Model:
         return System(name=self.name, description=self.description, x=x, u=u, d=Signals(group="disturbance"),
                       p=p, y=x.renamed(group="output"), f=f, h=h, p0=np.zeros(2), u_min=self.u_min,
                       u_max=self.u_max, constants=self.parameters,
-                      source=f"uvsym vehicle library ({self.name}): M (nu' - nu_c') + h(eta, nu_r) = tau(u)")
+                      source=f"uvsym vehicle library ({self.name}): M (nu' - nu_c') + h(eta, nu_r) = tau(u)",
+                      extras={"vehicle": self})
 
     def summary(self) -> dict:
         """JSON-friendly description: sizes, labels, units, mass matrix and parameters."""

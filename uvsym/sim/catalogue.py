@@ -6,32 +6,35 @@ design parameters of its type. Gains are designed from them here (an LQR from it
 Luenberger gain by LMI from a decay rate), never typed in the file, unless the file gives the
 gain itself. Units are SI, as everywhere in uvsym.
 
-===============  ==============================================================================
-type             fields (besides type and name)
-===============  ==============================================================================
-pid              measured, output (signal names), reference (number or signal name), kp, ki, kd,
-                 limits = [lo, hi]
-state_feedback   gain (m x n), reads (n names), publishes (m names), x_ref, u_ref
-lqr              q, r (weights: a list of the diagonal or a full matrix), reads (default: the
-                 plant's states), publishes (default: the plant's inputs)
-open_loop        times (s), values (one row per time), publishes, interpolation
-luenberger       decay (1/s, LMI design certified in exact arithmetic) or gain (n x n_y)
-ukf, ekf         q, r, p0 (covariances: a number, the diagonal or a full matrix)
-lms              measured, regressor, reference (signal names), order, mu, eps0, r0, window,
-                 hold, confirm (samples)
-uio_bank         poles (F's n eigenvalues), measured (outputs), decouple (disturbances): one UIO
-                 per input, publishing r_<input>_<output> (:mod:`uvsym.sim.uio_block`)
-hybrid           z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
-                 estimator), model, x0 (:mod:`uvsym.sim.hybrid_block`)
-select           flag, on, off, output (signal names; on, off, output one name or n each): a
-                 switch of the same sample, ``output = flag ? on : off`` (substitution from the
-                 sample the flag rises; ``[substitutions]`` switch from the next sample)
-autopilot        waypoints, lookahead, turn_radius, acceptance, speed, speed_loop, heading_loop,
-                 mix, reads, limits, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
-mmae             filter (ukf, ekf), models (hypothesis = inputs with an efficiency state), q, r,
-                 p0, x0, efficiency_p0, walk_std, floor, prior, reset, steps, alpha, beta, kappa
-                 (:mod:`uvsym.observers.mmae_design`)
-===============  ==============================================================================
+=================  ==============================================================================
+type               fields (besides type and name)
+=================  ==============================================================================
+pid                measured, output (signal names), reference (number or signal name), kp, ki, kd,
+                   limits = [lo, hi]
+state_feedback     gain (m x n), reads (n names), publishes (m names), x_ref, u_ref
+lqr                q, r (weights: a list of the diagonal or a full matrix), reads (default: the
+                   plant's states), publishes (default: the plant's inputs)
+open_loop          times (s), values (one row per time), publishes, interpolation
+luenberger         decay (1/s, LMI design certified in exact arithmetic) or gain (n x n_y)
+ukf, ekf           q, r, p0 (covariances: a number, the diagonal or a full matrix)
+lms                measured, regressor, reference (signal names), order, mu, eps0, r0, window,
+                   hold, confirm (samples)
+uio_bank           poles (F's n eigenvalues), measured (outputs), decouple (disturbances): one UIO
+                   per input, publishing r_<input>_<output> (:mod:`uvsym.sim.uio_block`)
+hybrid             z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
+                   estimator), model, x0 (:mod:`uvsym.sim.hybrid_block`)
+select             flag, on, off, output (signal names; on, off, output one name or n each): a
+                   switch of the same sample, ``output = flag ? on : off`` (substitution from the
+                   sample the flag rises; ``[substitutions]`` switch from the next sample)
+autopilot          waypoints, lookahead, turn_radius, acceptance, speed, speed_loop, heading_loop,
+                   mix, reads, limits, saturate (LOS guidance with PID loops, :mod:`uvsym.sim.autopilot`)
+actuator_observer  kind, form, time_constant, tau_d, commands: Liu et al.'s actuator-fault observer on
+                   a vehicle plant, publishing tau_d.<force> and f_hat.<force>
+                   (:mod:`uvsym.sim.actuator_block`)
+mmae               filter (ukf, ekf), models (hypothesis = inputs with an efficiency state), q, r,
+                   p0, x0, efficiency_p0, walk_std, floor, prior, reset, steps, alpha, beta, kappa
+                   (:mod:`uvsym.observers.mmae_design`)
+=================  ==============================================================================
 """
 
 from __future__ import annotations
@@ -232,6 +235,12 @@ def _autopilot(fields: Fields, plant: System, dt: float, name: str) -> Block:
     return autopilot_block(fields, plant, dt, name)
 
 
+def _actuator_observer(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.sim.actuator_block import actuator_observer_block
+
+    return actuator_observer_block(fields, plant, dt, name)
+
+
 def _mmae(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.observers.mmae_design import designed_bank
 
@@ -241,7 +250,8 @@ def _mmae(fields: Fields, plant: System, dt: float, name: str) -> Block:
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
           "uio_bank": _uio_bank, "hybrid": hybrid_block,
-          "select": _select, "autopilot": _autopilot, "mmae": _mmae}
+          "select": _select, "autopilot": _autopilot, "mmae": _mmae,
+          "actuator_observer": _actuator_observer}
 
 
 def build_block(fields: Fields, plant: System, dt: float) -> Block:

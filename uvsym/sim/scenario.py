@@ -359,22 +359,32 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
     for the whole run (the sensors' specification)."""
     if fields is None:
         return None
-    defaults = DiagnosisSettings()
-    name = fields.text("observer", defaults.observer, choices=("bias",))
+    name = fields.text("observer", DiagnosisSettings().observer, choices=("bias",))
     if name not in [observer.kind for observer in observers]:
         raise ScenarioError("diagnosis.observer: the diagnosis reads the bias observer's estimate, and the scenario "
                             "runs none; add [[observers]] with kind = \"bias\"")
+    noise = {model.state_labels[f.channel]: f.value for f in sensor_faults
+             if f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end)}
+    return diagnosis_settings(fields, model, name, noise, duration, step)
+
+
+def diagnosis_settings(fields: _Fields, model: Model, observer: str, noise: dict[str, float], duration: float,
+                       step: float) -> DiagnosisSettings:
+    """The :class:`~uvsym.diagnosis.DiagnosisSettings` of a table (every field but ``observer``, given),
+    for a run of ``duration`` s sampled every ``step`` s; noise: measured channel -> standard deviation
+    the table's ``noise`` defaults to. ScenarioError naming the field."""
+    defaults = DiagnosisSettings()
     lists = {}
     rules = {"kinds": "fault kinds: " + ", ".join(ACTUATOR_KINDS),
              "actuators": "the vehicle's input labels (none: all)"}
     for key, known in (("kinds", ACTUATOR_KINDS), ("actuators", model.input_labels)):
         value = fields.raw(key, list(getattr(defaults, key)), "list of strings", rules[key])
         if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise ScenarioError(f"diagnosis.{key}: expected a list of names, got {value!r}")
+            raise ScenarioError(f"{fields.path}.{key}: expected a list of names, got {value!r}")
         for item in value:
             if item not in known:
                 near = difflib.get_close_matches(item, list(known), n=1)
-                raise ScenarioError(f"diagnosis.{key}: unknown name {item!r}" + (f" (did you mean {near[0]!r}?)"
+                raise ScenarioError(f"{fields.path}.{key}: unknown name {item!r}" + (f" (did you mean {near[0]!r}?)"
                                     if near else "") + f"; known: {', '.join(known)}")
         lists[key] = tuple(value)
     numbers = {key: fields.number(key, getattr(defaults, key), positive=True)
@@ -386,26 +396,23 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
     noise_fields = fields.table("noise")
     fields.describe("noise.<channel>", "number", "standard deviation of a measured channel's noise",
                     "the scenario's noise faults")
-    if noise_fields is None:
-        noise = {model.state_labels[f.channel]: f.value for f in sensor_faults
-                 if f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end)}
-    else:
+    if noise_fields is not None:
         noise = {channel: noise_fields.number(channel, minimum=0.0) for channel in list(noise_fields.data)}
         for channel in noise:
             if channel not in model.state_labels:
-                raise ScenarioError(f"diagnosis.noise.{channel}: unknown measured channel; known: "
+                raise ScenarioError(f"{fields.path}.noise.{channel}: unknown measured channel; known: "
                                     f"{', '.join(model.state_labels)}")
     fields.done()
     if numbers["window_s"] >= duration:
-        raise ScenarioError(f"diagnosis.window_s: {numbers['window_s']:g} s is not shorter than the run "
+        raise ScenarioError(f"{fields.path}.window_s: {numbers['window_s']:g} s is not shorter than the run "
                             f"({duration:g} s): no window would ever be tested")
     if abs(numbers["period_s"] / step - round(numbers["period_s"] / step)) > 1e-9 or numbers["period_s"] < step:
-        raise ScenarioError(f"diagnosis.period_s: {numbers['period_s']:g} s is not a whole number of steps "
+        raise ScenarioError(f"{fields.path}.period_s: {numbers['period_s']:g} s is not a whole number of steps "
                             f"({step:g} s)")
     try:
-        return DiagnosisSettings(observer=name, confirm=confirm, correct=correct, noise=noise, **lists, **numbers)
-    except DiagnosisError as exc:
-        raise ScenarioError(str(exc)) from None
+        return DiagnosisSettings(observer=observer, confirm=confirm, correct=correct, noise=noise, **lists, **numbers)
+    except DiagnosisError as exc:  # its message names the field as diagnosis.<field>
+        raise ScenarioError(str(exc).replace("diagnosis.", f"{fields.path}.", 1)) from None
 
 
 def _check_size(duration: float, step: float, model: Model, n_observers: int) -> None:

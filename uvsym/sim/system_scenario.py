@@ -49,6 +49,9 @@ switches in the same sample) and ``[[detectors]]``:
   0.02: an efficiency estimate is published where it stays within it over settle samples),
   ``ignore_before`` (s), ``kind`` (default proportional): the
   bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`).
+- ``type = "fault_diagnosis"``: ``observer`` (an actuator_observer block of kind bias, on a
+  vehicle plant) and the fields of a vehicle scenario's [diagnosis] table but ``correct``: the
+  continuous actuator diagnosis on the finished record (:mod:`uvsym.diagnosis.wired`).
 
 Units are SI (m, s, rad, N, A, V) as everywhere in uvsym.
 """
@@ -310,13 +313,18 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
         lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
         raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
                             f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
-    block, regressor = blocks[monitor], blocks[monitor].reads.names[1]
-    if "." not in regressor:  # the logged signal it names: the publishing block's, else the plant input
-        regressor = next((f"{b.name}.{regressor}" for b in scenario_loop.blocks if regressor in b.publishes.names),
-                         f"u.{regressor}")
+    block, regressor = blocks[monitor], logged_input(blocks[monitor].reads.names[1], scenario_loop)
     order = sum(n.startswith("C_") for n in block.state.names)  # the filter's weights C_1 .. C_M
     return DoubleCriterion(name, monitor, block.reads.names[0], block.description, block.parameters, regressor,
                            order)
+
+
+def logged_input(name: str, scenario_loop: WiredLoop) -> str:
+    """The logged signal a block's read ``name`` of an input is: as given when qualified, else
+    ``<block>.<name>`` of the block that publishes it, else the plant input ``u.<name>``."""
+    if "." in name:
+        return name
+    return next((f"{b.name}.{name}" for b in scenario_loop.blocks if name in b.publishes.names), f"u.{name}")
 
 
 def _logged(name: str, scenario_loop: WiredLoop, where: str) -> str:
@@ -399,6 +407,14 @@ def _hybrid_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np
     return EstimatedFault(name, _threshold_detector(fields, name, scenario_loop, z0, w0, step), estimate, **options)
 
 
+def _fault_diagnosis(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                     step: float):
+    """``type = "fault_diagnosis"`` (:mod:`uvsym.diagnosis.wired`, imported only for one)."""
+    from uvsym.diagnosis.wired import fault_diagnosis_detector
+
+    return fault_diagnosis_detector(fields, name, scenario_loop, z0, w0, step)
+
+
 def _mmae(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
     """``type = "mmae"`` (:mod:`uvsym.diagnosis.hypotheses`, imported only for one)."""
     from uvsym.diagnosis.hypotheses import mmae_detector
@@ -407,7 +423,7 @@ def _mmae(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w
 
 
 DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands,
-             "hybrid": _hybrid_detector, "mmae": _mmae}
+             "hybrid": _hybrid_detector, "mmae": _mmae, "fault_diagnosis": _fault_diagnosis}
 
 
 def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray, step: float):
