@@ -120,6 +120,18 @@ def test_dotted_paths_create_merge_and_replace():
         parse_path("faults..onset")
 
 
+def test_a_path_into_an_entry_the_scenario_lacks_is_named_as_such(tmp_path):
+    from uvsym.campaign.dotted import new_entry
+
+    assert new_entry({"faults": [{}]}, "faults[1].value") == "faults[1]"
+    assert new_entry({"faults": [{}]}, "faults[0].value") is None
+    assert new_entry({}, "current.speed") is None
+    text = GRID.replace('"faults" = [[]]\n', "").replace('"faults[0].actuator" = ["X"]', '"faults[3].value" = [1.0]')
+    with pytest.raises(CampaignError, match=r"faults\[3\]: give either .*\(faults\[3\] is not in the scenario: the "
+                                            r"case's paths made it"):
+        load_campaign(_write(tmp_path, text))
+
+
 def test_grid_is_the_product_of_the_axes_in_file_order(tmp_path):
     campaign = load_campaign(_write(tmp_path, GRID))
     assert len(campaign.runs) == 1 * 1 * 2 * 2 * 2

@@ -267,3 +267,14 @@ def test_verify_prints_each_claim_readably_in_100_columns(tmp_path, capsys):
                           "margin": None, "seconds": 1.0})
     assert block.startswith("!! REFUTED (expected proved") and "polytope" in block
     assert all(len(line) <= 100 and not line.endswith(("contra", "verte")) for line in block.splitlines())
+
+
+@pytest.mark.parametrize("arguments, kind", [(["--schema"], "vehicle"), (["--schema", "plant"], "plant"),
+                                             (["docking_faults", "--schema"], "vehicle"),
+                                             (["docking_auv_thruster_bias", "--schema"], "plant"),
+                                             (["docking_auv_thruster_bias", "--schema", "vehicle"], "vehicle")])
+def test_schema_is_of_the_kind_named_else_of_the_scenario_given(arguments, kind, capsys):
+    from uvsym.sim.schema import schema_markdown
+
+    assert main(["simulate", *arguments]) == 0
+    assert capsys.readouterr().out.strip() == schema_markdown(kind)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from problems import DT, first_order, integrator
 
+from uvsym.faults import ActuatorFault, Profile
 from uvsym.sim import lqr, lqr_gain, open_loop, pid, simulate_system
 from uvsym.systems import signals, system
 
@@ -83,5 +84,8 @@ def test_quick_look_of_a_wired_loop_shows_states_inputs_and_blocks(tmp_path):
     result = simulate_system(first_order(), [controller], duration=1.0, dt=DT, x0=[0.0])
     figure = result.plot(tmp_path / "loop.svg")
     titles = [ax.get_title(loc="left") for ax in figure.axes]
-    assert titles == ["x (m/s)", "u (N)", "c (N)"]
+    assert titles == ["x (m/s)", "u (N)"]  # the command is the plant input: drawn once
     assert (tmp_path / "loop.svg").read_text().startswith("<?xml")
+    faulty = simulate_system(first_order(), [controller], duration=1.0, dt=DT, x0=[0.0],
+                             actuator_faults=(ActuatorFault(0, "bias", 0.5, Profile(onset=0.5)),))
+    assert [ax.get_title(loc="left") for ax in faulty.plot().axes] == ["x (m/s)", "u (N)", "c (N)"]

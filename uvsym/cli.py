@@ -160,10 +160,13 @@ def _cmd_simulate(args) -> int:
     from uvsym.sim.scenario import read_scenario_file, shipped_scenarios
     from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
 
-    if args.schema:
+    if args.schema is not False:  # the kind named, else the given file's, else the vehicle format
         from uvsym.sim.schema import schema_markdown
+        from uvsym.sim.system_scenario import is_system_scenario
 
-        print(schema_markdown(args.schema))
+        kind = args.schema or ("plant" if args.scenario and is_system_scenario(
+            read_scenario_file(_scenario_path(args.scenario))) else "vehicle")
+        print(schema_markdown(kind))
         return 0
     if args.list or not args.scenario:
         rows = [[name, "", str(path.name)] for name, path in shipped_scenarios().items()]
@@ -467,9 +470,10 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--plot", nargs="?", const="", default=None,
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
-    simulate.add_argument("--schema", nargs="?", const="vehicle", choices=["vehicle", "plant"],
+    simulate.add_argument("--schema", nargs="?", const=None, default=False, choices=["vehicle", "plant"],
                           help="print every field of a vehicle scenario file, or (plant) of a scenario over a "
-                               "plant (type, default, rule) as a Markdown table")
+                               "plant (type, default, rule) as a Markdown table; with a scenario and no kind, "
+                               "the fields of its format")
     simulate.add_argument("--events", help="write the diagnosis's decision log (.json; needs a [diagnosis] table)")
     simulate.add_argument("--force", action="store_true", help="overwrite an existing --out, --plot or --events file")
     simulate.set_defaults(run=_cmd_simulate)

@@ -13,7 +13,7 @@ import re
 
 from uvsym.errors import CampaignError
 
-__all__ = ["parse_path", "set_path", "flatten"]
+__all__ = ["parse_path", "set_path", "flatten", "new_entry"]
 
 _STEP = re.compile(r"(?P<key>[A-Za-z0-9_-]+)(?P<indices>(?:\[\d+\])*)")
 
@@ -71,6 +71,19 @@ def set_path(data: dict, path: str, value) -> None:
         node = node[step]
         if not isinstance(node, (dict, list)):
             raise CampaignError(f"{path}: {where} is a {type(node).__name__}, not a table or list")
+
+
+def new_entry(data: dict, path: str) -> str | None:
+    """The list entry (``faults[1]``) that setting ``path`` in ``data`` would make, or None."""
+    node, steps = data, parse_path(path)
+    for depth, step in enumerate(steps):
+        if isinstance(step, int) and isinstance(node, list) and step >= len(node):
+            return _shown(steps[:depth + 1])
+        if isinstance(node, dict) and step in node or isinstance(node, list) and isinstance(step, int):
+            node = node[step]
+        else:
+            return None
+    return None
 
 
 def _shown(steps) -> str:

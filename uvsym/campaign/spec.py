@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uvsym.campaign.dotted import flatten, parse_path, set_path
+from uvsym.campaign.dotted import flatten, new_entry, parse_path, set_path
 from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError
 from uvsym.sim.fields import Fields
 from uvsym.sim.scenario import every_shipped_scenario, read_scenario_file
@@ -325,6 +325,8 @@ def _expand(spec: dict) -> list[Run]:
     """The case's runs in order (grid points in product order, draws within each), each parsed."""
     name, where = spec["name"], f"case {spec['name']!r}"
     paths = [path for path, _ in spec["axes"]]
+    drawn_paths = [path for path, _, _ in spec["draws"][2]] if spec["draws"] else []
+    made = [entry for entry in (new_entry(spec["base"], path) for path in paths + drawn_paths) if entry]
     runs = []
     for point in itertools.product(*(values for _, values in spec["axes"])):
         table = copy.deepcopy(spec["base"])
@@ -333,7 +335,7 @@ def _expand(spec: dict) -> list[Run]:
             _apply(table, path, value, f"{where}: grid axis {path!r}")
             fields |= flatten(path, value)
         if spec["draws"] is None:
-            runs.append(_run(name, None, fields, table, spec["scenario"]))
+            runs.append(_run(name, None, fields, table, spec["scenario"], made))
             continue
         count, seed, distributions = spec["draws"]
         digest = hashlib.sha256(json.dumps([name, point], sort_keys=True, default=str).encode()).digest()
@@ -345,16 +347,22 @@ def _expand(spec: dict) -> list[Run]:
                 value = _draw(rng, kind, args)
                 _apply(drawn, path, value, f"{where}: monte_carlo field {path!r}")
                 drawn_fields |= flatten(path, value)
-            runs.append(_run(name, draw, drawn_fields, drawn, spec["scenario"]))
+            runs.append(_run(name, draw, drawn_fields, drawn, spec["scenario"], made))
     return runs
 
 
-def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str) -> Run:
+def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str, made=()) -> Run:
+    """The parsed run; made: list entries (``faults[1]``) the case's paths add to its scenario (named
+    in an error that is about one of them)."""
     try:
         parse_any_scenario(table, default_name=scenario_name)
     except UvsymError as exc:
+        about = [entry for entry in made if str(exc).startswith(entry)]
+        hint = (f" ({about[0]} is not in the scenario: the case's paths made it from the fields they set; to add "
+                f"an entry set all of it, e.g. set = {{ \"{about[0]}\" = {{ ... }} }}, or index an existing one)"
+                if about else "")
         raise CampaignError(f"case {case!r}, run {_describe(fields)}"
-                            + ("" if draw is None else f", draw {draw}") + f": {exc}") from None
+                            + ("" if draw is None else f", draw {draw}") + f": {exc}{hint}") from None
     table.setdefault("name", scenario_name)
     key = json.dumps({"case": case, "scenario": table}, sort_keys=True, default=str)
     return Run(id=hashlib.sha256(key.encode()).hexdigest()[:16], case=case, draw=draw, fields=fields,

@@ -157,7 +157,8 @@ class SimResult:
         (checked by :meth:`check_plot_path`: an existing file is kept unless ``overwrite``).
 
         Default signals: states, commands and fault estimates of a scenario run; states, inputs
-        and every block's published signals of a wired loop. Every panel marks the faults' onsets
+        and every block's published signals of a wired loop (a command drawn once, as the plant
+        input, where no actuator fault makes the two differ). Every panel marks the faults' onsets
         (dashed red; whole-run sensor noise is not a fault) and the detectors' alarms (detected,
         isolated or identified: dotted black), from the result's meta and decision log."""
         if path is not None:
@@ -172,11 +173,14 @@ class SimResult:
                 n for n in self.signals if n.startswith("f_hat/"))
         elif not names:  # a wired loop: states, inputs and every block's signals
             names = tuple(n for n in self.signals if n not in ("y", "fault_sensor", "fault_actuator", "substitution"))
+        inputs = dict(zip(self["u"].labels, self["u"].values.T)) if "u" in self.signals else {}
         panels = []
         for name in names:
             sig = self[name]
             groups: dict[str, list] = {}
             for label, unit, column in zip(sig.labels, sig.units, sig.values.T):
+                if name != "u" and label in inputs and np.array_equal(column, inputs[label]):
+                    continue  # a command the plant input shows as it is (no actuator fault on it)
                 scale, shown = (180.0 / np.pi, unit.replace("rad", "deg")) if "rad" in unit else (1.0, unit)
                 groups.setdefault(shown, []).append((label, scale * column))
             panels += [(f"{name} ({unit})", lines) for unit, lines in groups.items()]
