@@ -27,13 +27,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import finish  # noqa: E402
 
 from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
-from uvsym.verify.enclosure_check import BOX_KINDS, OPERATIONS, enclosure_violations, random_box
+from uvsym.verify.enclosure_check import BINARY, BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.identity import prove_identity
 from uvsym.verify.lyapunov import discrete_lyapunov_decrease, lyapunov_decrease
 from uvsym.verify.region import region_decrease
 
 RESULTS = Path(__file__).resolve().parent / "results" / "soundness.json"
-BINARY = {"add", "sub", "mul", "div", "fmin", "fmax"}
 
 
 def _tally(outcomes: list[tuple[str, bool]], seconds: float, examples: list[str]) -> dict:

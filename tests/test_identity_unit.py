@@ -18,7 +18,7 @@ import sympy as sp
 from uvsym.verify import prove_identity
 from uvsym.verify.identity import _points, _rational_function
 
-SAMPLED = ("sampled: 30 points over {where}, mpmath 50 digits, each entry against the size of its terms, to the "
+SAMPLED = ("sampled: {points} points over {where}, mpmath 50 digits, each entry against the size of its terms, to the "
            "precision of the model's double constants (evidence, not a proof)")
 
 
@@ -50,14 +50,16 @@ def test_sampling_evaluates_thirty_points_against_the_size_of_the_terms():
     certificate = prove_identity("near", x * (1 + 1e-13), x, [x], "all x", symbolic_seconds=1.0)
     a = Fraction(1 + 1e-13)
     assert certificate.status == "checked" and certificate.reason == "not shown zero symbolically"
-    assert certificate.method == SAMPLED.format(where="the reals at scales 1e-3 to 1e8")
-    assert certificate.details["points"] == 30
+    # 30 drawn, and 4 where sign, |.|, floor, fmod and copysign jump: x = 0, +-1/2, +-3/2
+    assert certificate.method == SAMPLED.format(points=34, where="the reals at scales 1e-3 to 1e8")
+    assert certificate.details["points"] == 34
     assert certificate.details["largest_relative_difference"] == float((a - 1) / (a + 1))
 
 
 def test_the_default_seed_is_zero_and_the_seed_moves_the_points():
     x, y = ca.SX.sym("x"), ca.SX.sym("y")
-    lhs, rhs = x * (1 + 1e-13) + y, x + y  # relative difference 1e-13 |x| / (2 |x| + 2 |y|): depends on the point
+    # relative difference 1e-13 |x| / (2 |x| + 2 |y| + 2): depends on the point, largest at the drawn large |x|
+    lhs, rhs = x * (1 + 1e-13) + y + 1, x + y + 1
     default = prove_identity("near", lhs, rhs, [x, y], "all x, y", symbolic_seconds=1.0)
     zero = prove_identity("near", lhs, rhs, [x, y], "all x, y", seed=0, symbolic_seconds=1.0)
     one = prove_identity("near", lhs, rhs, [x, y], "all x, y", seed=1, symbolic_seconds=1.0)
@@ -72,7 +74,7 @@ def test_a_box_is_sampled_instead_of_the_reals():
     certificate = prove_identity("|x| = x", ca.fabs(x), x, [x], "1 <= x <= 2", box=([1.0], [2.0]),
                                  symbolic_seconds=1.0)
     assert certificate.status == "checked"
-    assert certificate.method == SAMPLED.format(where="the stated box")
+    assert certificate.method == SAMPLED.format(points=30, where="the stated box")
 
 
 def test_a_point_where_both_sides_and_their_size_vanish_counts_as_no_difference():
@@ -97,7 +99,7 @@ def test_transcendental_terms_are_evaluated_with_mpmath():
     x = ca.SX.sym("x")
     certificate = prove_identity("near", ca.sin(x) * (1 + 1e-13), ca.sin(x), [x], "all x", symbolic_seconds=1.0)
     a = Fraction(1 + 1e-13)
-    assert certificate.status == "checked" and certificate.details["points"] == 30
+    assert certificate.status == "checked" and certificate.details["points"] == 34
     assert certificate.details["largest_relative_difference"] == float((a - 1) / (a + 1))
 
 
@@ -276,10 +278,10 @@ def test_the_recheck_raises_its_precision_to_four_hundred_digits_and_no_further(
 
 
 def test_an_operation_without_an_interval_extension_is_never_refuted():
-    # 2 floor(x) against floor(x) at x = 1.5: relative difference 1/3, plainly false, but floor has no
-    # outward-rounded mpmath extension here: inconclusive, with the unconfirmed difference in the reason
+    # 2 erf(x) against erf(x) at x = 1.5: relative difference 1/3, plainly false, but erf has no
+    # outward-rounded extension here: inconclusive, with the unconfirmed difference in the reason
     x = ca.SX.sym("x")
-    certificate = prove_identity("2 floor = floor", 2 * ca.floor(x), ca.floor(x), [x], "x = 1.5", box=([1.5], [1.5]),
+    certificate = prove_identity("2 erf = erf", 2 * ca.erf(x), ca.erf(x), [x], "x = 1.5", box=([1.5], [1.5]),
                                  symbolic_seconds=1.0)
     assert certificate.status == "inconclusive" and certificate.margin == -1 / 3
     assert certificate.reason == ("not shown zero symbolically; largest relative difference 0.333 is above 1e-10 at "
@@ -287,10 +289,13 @@ def test_an_operation_without_an_interval_extension_is_never_refuted():
 
 
 @pytest.mark.parametrize("operation", [lambda a: ca.fmin(a, 1), lambda a: ca.fmax(a, 1), ca.sign,
-                                       lambda a: ca.if_else(a > 1, a, 2 * a)], ids=["fmin", "fmax", "sign", "if_else"])
+                                       lambda a: ca.if_else(a > 1, a, 2 * a), ca.floor, ca.ceil,
+                                       lambda a: ca.fmod(a, 1.25), lambda a: ca.copysign(a, a - 2)],
+                         ids=["fmin", "fmax", "sign", "if_else", "floor", "ceil", "fmod", "copysign"])
 def test_a_difference_through_a_decided_branch_is_refuted_by_mpmath_intervals(operation):
-    # 2 op(x) + tan(x) against op(x) + tan(x) at x = 1.5 (op(x) = 1, 1.5, 1, 1.5): relative difference 1/3; tan leaves
-    # the CasADi graph's intervals out, and mpmath's decide min, max, sign and the branch at the point
+    # 2 op(x) + tan(x) against op(x) + tan(x) at x = 1.5 (op(x) = 1, 1.5, 1, 1.5, 1, 2, 0.25, -1.5): tan leaves
+    # the CasADi graph's intervals out, and mpmath's decide min, max, sign, the branch, floor, ceil, C's fmod
+    # and copysign at the point
     x = ca.SX.sym("x")
     certificate = prove_identity("2 op = op", 2 * operation(x) + ca.tan(x), operation(x) + ca.tan(x), [x], "x = 1.5",
                                  box=([1.5], [1.5]), symbolic_seconds=1.0)

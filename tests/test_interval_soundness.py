@@ -15,11 +15,10 @@ from hypothesis import strategies as st
 from uvsym.errors import VerificationError
 from uvsym.verify import enclosure_check
 from uvsym.verify.borderline import identity_cases, region_cases
-from uvsym.verify.enclosure_check import BOX_KINDS, OPERATIONS, enclosure_violations, random_box
+from uvsym.verify.enclosure_check import BINARY, BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.interval import IntervalFunction
 
-UNARY = [name for name in OPERATIONS if name not in ("add", "sub", "mul", "div", "fmin", "fmax")]
-BINARY = ["add", "sub", "mul", "div", "fmin", "fmax"]
+UNARY = [name for name in OPERATIONS if name not in BINARY]
 
 
 def _bound(kind: str):

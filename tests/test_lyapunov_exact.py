@@ -249,7 +249,8 @@ def test_each_continuous_outcome_states_its_method_and_keeps_the_expected_label(
     refuted = lyapunov_decrease("too fast", [MINUS_I], 1.5, "one matrix", expected="refuted")
     assert _timed(refuted) == Certificate(
         "too fast", "one matrix", "Routh-Hurwitz on det(sI - A - gamma I) of a vertex, in exact rationals: an "
-        "eigenvalue with real part >= -gamma", "refuted", "refuted", margin=pytest.approx(-0.5),
+        "eigenvalue with real part >= -gamma (no P satisfies the strict LMI)", "refuted", "refuted",
+        margin=pytest.approx(-0.5),
         counterexample={"A": MINUS_I.tolist(), "gamma": 1.5, "eigenvalue_real": -1.0, "eigenvector_real": [1.0, 0.0],
                         "exact_test": "Routh-Hurwitz"})
     solver_answer([[7.0, 1.0], [1.0, 1.0 / 7.0]])
@@ -263,3 +264,12 @@ def test_each_continuous_outcome_states_its_method_and_keeps_the_expected_label(
     assert _timed(undecided) == Certificate(
         "hull", "two vertices", "LMI (cvxpy, Clarabel)", "inconclusive", "refuted",
         reason="every vertex is stable at rate gamma (exact Routh-Hurwitz), but no common P: LMI status infeasible")
+
+
+def test_the_conditions_decided_are_the_strict_ones_the_docstrings_state():
+    A = np.diag([-1.0, -2.0])  # P = I gives A'P + PA + 2P = diag(0, -2): <= 0 holds, < 0 does not
+    assert lyapunov_decrease("at rate 1", [A], 1.0, "one matrix").status == "refuted"
+    assert lyapunov_decrease("just below rate 1", [A], 0.999, "one matrix").status == "proved"
+    Ad = np.diag([0.5, 0.25])  # V+ = rho^2 V on the first axis at rho = 0.5: only the non-strict bound holds
+    assert discrete_lyapunov_decrease("at rate 0.5", Ad, 0.5, "one matrix").status == "refuted"
+    assert discrete_lyapunov_decrease("just above", Ad, 0.5001, "one matrix").status == "proved"

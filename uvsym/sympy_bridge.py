@@ -38,8 +38,9 @@ _UNARY = {
 _BINARY = {
     ca.OP_ADD: lambda a, b: a + b, ca.OP_SUB: lambda a, b: a - b, ca.OP_MUL: lambda a, b: a * b,
     ca.OP_DIV: lambda a, b: a / b, ca.OP_POW: lambda a, b: a**b, ca.OP_CONSTPOW: lambda a, b: a**b,
-    ca.OP_ATAN2: sp.atan2, ca.OP_FMIN: sp.Min, ca.OP_FMAX: sp.Max, ca.OP_HYPOT: lambda a, b: sp.sqrt(a**2 + b**2),
-    ca.OP_FMOD: sp.Mod, ca.OP_COPYSIGN: lambda a, b: sp.Abs(a) * sp.sign(b),
+    ca.OP_ATAN2: lambda y, x: _c_atan2(y, x), ca.OP_FMIN: sp.Min, ca.OP_FMAX: sp.Max,
+    ca.OP_HYPOT: lambda a, b: sp.sqrt(a**2 + b**2), ca.OP_FMOD: lambda a, b: _c_fmod(a, b),
+    ca.OP_COPYSIGN: lambda a, b: _c_copysign(a, b),
     ca.OP_LT: lambda a, b: _indicator(sp.Lt(a, b)), ca.OP_LE: lambda a, b: _indicator(sp.Le(a, b)),
     ca.OP_EQ: lambda a, b: _indicator(sp.Eq(a, b)), ca.OP_NE: lambda a, b: _indicator(sp.Ne(a, b)),
     ca.OP_AND: lambda a, b: _indicator(sp.And(sp.Ne(a, 0), sp.Ne(b, 0))),
@@ -50,6 +51,25 @@ _BINARY = {
 
 def _indicator(condition):
     return sp.Piecewise((1, condition), (0, True))
+
+
+# C's semantics where sympy's functions differ (a real zero is +0: IEEE's -0.0 has no real counterpart)
+def _c_fmod(a, b):
+    """C fmod: ``a - b trunc(a / b)``, the sign of a (sympy's Mod is floored: the sign of b); NaN at b = 0."""
+    if b == 0:
+        return sp.nan
+    q = a / b
+    return a - b * sp.Piecewise((sp.floor(q), q >= 0), (sp.ceiling(q), True))
+
+
+def _c_copysign(a, b):
+    """C copysign: |a| with the sign of b, so |a| at b = 0 (``|a| sign(b)`` would give 0 there)."""
+    return sp.Piecewise((sp.Abs(a), b >= 0), (-sp.Abs(a), True))
+
+
+def _c_atan2(y, x):
+    """C atan2: 0 at y = x = 0 (sympy's atan2 is undefined there), sympy's atan2 elsewhere."""
+    return sp.Piecewise((0, sp.And(sp.Eq(y, 0), sp.Eq(x, 0))), (sp.atan2(y, x), True))
 
 
 def _constant(value: float, exact: bool = False):

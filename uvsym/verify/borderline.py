@@ -14,6 +14,11 @@ Each case states a claim and whether it holds, decided independently of the veri
 - :func:`linear_cases`: matrices with exact eigenvalues (triangular with dyadic diagonals, Jordan
   blocks conjugated by integer unimodular matrices, companion matrices of ``(s - lambda)^n``) and a
   rate gamma (or a radius rho) at, just above or just below the boundary.
+- :func:`c_semantics_cases`: identities over the operations whose C meaning differs from the
+  textbook one at their kinks (fmod, copysign, floor, ceil, sign, fmin/fmax, atan2, fabs): ones that
+  C's semantics makes true for any arguments (random expressions of x and y put in), and ones false
+  at a point C gives (``fmod(x + 1, 1)`` against ``fmod(x, 1)`` at x = -0.5, ``copysign(|x| + c, y)``
+  against ``(|x| + c) sign(y)`` at y = 0, ...).
 - :func:`identity_cases`: false identities (a relative error of 1e-15 to 1e-11; an error that
   matters only for ``|x|`` beyond 1e5..1e7; only near one point; in a small entry beside a large one) and true ones
   that cancel badly in floating point (``1 - tanh(x + c)`` against ``2 / (exp(2 (x + c)) + 1)``).
@@ -28,7 +33,8 @@ import casadi as ca
 import mpmath
 import numpy as np
 
-__all__ = ["IdentityCase", "LinearCase", "RegionCase", "identity_cases", "linear_cases", "region_cases"]
+__all__ = ["IdentityCase", "LinearCase", "RegionCase", "c_semantics_cases", "identity_cases", "linear_cases",
+           "region_cases", "C_SEMANTICS"]
 
 _TRANSCENDENTAL = {"sin": (ca.sin, mpmath.sin), "tanh": (ca.tanh, mpmath.tanh),
                    "expm1": (lambda x: ca.exp(x) - 1, mpmath.expm1)}
@@ -223,4 +229,58 @@ def identity_cases(count: int, seed: int = 0) -> list[IdentityCase]:
             c = float(rng.uniform(20, 200))
             lhs, rhs, holds = 1 - ca.tanh(x + c), 2 / (ca.exp(2 * (x + c)) + 1), True
         cases.append(IdentityCase(kind, lhs, rhs, [x], holds))
+    return cases
+
+
+def _c_true(a, b):
+    """Identities that hold in C for all real a, b where both sides are defined (a real zero is +0)."""
+    return {"copysign_magnitude": (ca.copysign(a, b), ca.copysign(ca.fabs(a), b)),
+            "copysign_square": (ca.copysign(1, b) ** 2, ca.SX(1)),
+            "fmod_odd": (ca.fmod(-a, b * b + 1), -ca.fmod(a, b * b + 1)),
+            "fmod_divisor_sign": (ca.fmod(a, -(b * b + 1)), ca.fmod(a, b * b + 1)),
+            "floor_ceil": (ca.floor(a), -ca.ceil(-a)),
+            "sign_abs": (ca.sign(a) * ca.fabs(a), a),
+            "fmin_fmax": (ca.fmin(a, b), -ca.fmax(-a, -b)),
+            "abs_copysign": (ca.fabs(a), ca.copysign(a, 1))}
+
+
+def _c_false(x, y, c):
+    """Identities false at some point of C's semantics (x, y symbols, c > 0)."""
+    return {"fmod_shift": (ca.fmod(x + 1, 1), ca.fmod(x, 1)),
+            "copysign_sign": (ca.copysign(ca.fabs(x) + c, y), (ca.fabs(x) + c) * ca.sign(y)),
+            "floor_odd": (ca.floor(x), -ca.floor(-x)),
+            "sign_square": (ca.sign(x) ** 2, ca.SX(1)),
+            "fmod_floored": (ca.fmod(x, 1 + c), x - (1 + c) * ca.floor(x / (1 + c))),
+            "fmin_is_fmax": (ca.fmin(x, y), ca.fmax(x, y)),
+            "ceil_floor": (ca.ceil(x), ca.floor(x) + 1),
+            "atan2_atan": (ca.atan2(y, x), ca.atan(y / x))}
+
+
+C_SEMANTICS = tuple(_c_true(0, 0)) + tuple(_c_false(ca.SX.sym("x"), ca.SX.sym("y"), 1.0))
+
+
+def _expression(rng, x, y, depth: int):
+    """A random expression of x and y over +, -, *, fabs, sign, floor, fmod, copysign, fmin, fmax."""
+    if depth == 0 or rng.uniform() < 0.3:
+        return [x, y, x + y, 2 * x - y, x * y][int(rng.integers(5))] + float(rng.choice([0.0, 0.5, -1.5]))
+    a, b = _expression(rng, x, y, depth - 1), _expression(rng, x, y, depth - 1)
+    return [a + b, a * b, ca.fabs(a), ca.sign(a) * b, ca.floor(a), ca.fmod(a, b * b + 1), ca.copysign(a, b),
+            ca.fmin(a, b), ca.fmax(a, b)][int(rng.integers(9))]
+
+
+def c_semantics_cases(count: int, seed: int = 0) -> list[IdentityCase]:
+    """``count`` identities over x and y (module docstring), the true and the false classes in turn."""
+    rng = np.random.default_rng(seed)
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")
+    cases = []
+    for k in range(count):
+        if k % 2 == 0:
+            kinds = _c_true(_expression(rng, x, y, 2), _expression(rng, x, y, 2))
+            holds = True
+        else:
+            kinds = _c_false(x, y, float(rng.uniform(0.1, 3.0)))
+            holds = False
+        kind = list(kinds)[(k // 2) % len(kinds)]
+        lhs, rhs = kinds[kind]
+        cases.append(IdentityCase(kind, lhs, rhs, [x, y], holds))
     return cases

@@ -9,6 +9,7 @@ break interval code: straddling 0, subnormal, huge (1e300), zero width, anything
 
 from __future__ import annotations
 
+import math
 from functools import cache
 
 import casadi as ca
@@ -17,7 +18,7 @@ import numpy as np
 
 from uvsym.verify.interval import IntervalFunction
 
-__all__ = ["BOX_KINDS", "OPERATIONS", "enclosure_violations", "random_box"]
+__all__ = ["BINARY", "BOX_KINDS", "OPERATIONS", "enclosure_violations", "random_box"]
 
 OPERATIONS = {
     "neg": (lambda a, b: -a, lambda a, b: -a, None),
@@ -50,7 +51,15 @@ OPERATIONS = {
     "div": (lambda a, b: a / b, lambda a, b: a / b, lambda a, b: b != 0),
     "fmin": (lambda a, b: ca.fmin(a, b), lambda a, b: min(a, b), None),
     "fmax": (lambda a, b: ca.fmax(a, b), lambda a, b: max(a, b), None),
+    "floor": (lambda a, b: ca.floor(a), lambda a, b: mpmath.floor(a), None),
+    "ceil": (lambda a, b: ca.ceil(a), lambda a, b: mpmath.ceil(a), None),
+    "sign": (lambda a, b: ca.sign(a), lambda a, b: mpmath.sign(a), None),
+    # C's fmod is exact in doubles (the sign of a): the library's own value is the oracle at a float point
+    "fmod": (lambda a, b: ca.fmod(a, b), lambda a, b: mpmath.mpf(math.fmod(float(a), float(b))),
+             lambda a, b: b != 0),
+    "copysign": (lambda a, b: ca.copysign(a, b), lambda a, b: abs(a) if b >= 0 else -abs(a), None),
 }
+BINARY = ("add", "sub", "mul", "div", "fmin", "fmax", "fmod", "copysign")
 BOX_KINDS = ("moderate", "straddle", "subnormal", "huge", "zero width", "any")
 
 

@@ -12,9 +12,10 @@ that takes longer is abandoned, never waited for):
    entry is a rational function of the symbols: its nonzero numerator already shows it is not zero.
 
 Otherwise the difference is sampled with mpmath at ``DIGITS`` significant digits, at points over
-the claim's stated set (its ``box``; without one, at scales from 1e-3 to 1e8 besides N(0, 2^2)
-and small integers). Each entry is measured against its own scale, the sum of the absolute values
-of the terms of its two sides (what the rounding of the model's double constants can move it by).
+the claim's stated set (its ``box``; without one, at scales from 1e-3 to 1e8 besides N(0, 2^2) and
+small integers, then at 0 and half-integers, where sign, abs, floor, fmod and copysign jump). Each entry is
+measured against its own scale, the sum of the absolute values of the terms of its two sides (what
+the rounding of the model's double constants can move it by).
 An entry above ``REFUTE`` (1e-10) refutes the claim once re-checked rigorously at the point: a lower
 bound of the gap must exceed twice the threshold times an upper bound of the size of the terms. The
 size is bounded by mpmath interval arithmetic (outward rounding, at ``RECHECK_DIGITS`` digits, each
@@ -97,12 +98,21 @@ def _symbolic_outcome(entries: list[sp.Expr], channel, seconds: float) -> None:
     for entry in entries:
         if exact_zero(entry):
             continue
-        if not _rational_function(entry) and sp.count_ops(entry) <= SIMPLIFY_OPS and sp.simplify(entry) == 0:
+        if not _rational_function(entry) and sp.count_ops(entry) <= SIMPLIFY_OPS and _simplifies_to_zero(entry):
             how = "simplify"
             continue
         how = ""
         break
     channel.send(how)
+
+
+def _simplifies_to_zero(entry: sp.Expr) -> bool:
+    """Whether sympy.simplify gives 0; False where simplify itself fails (it raises on some Piecewise
+    with undefined branches: not shown zero, which proves nothing either way)."""
+    try:
+        return sp.simplify(entry) == 0
+    except (ValueError, TypeError, ArithmeticError, RecursionError, NotImplementedError, AttributeError):
+        return False
 
 
 def _symbolic(entries: list[sp.Expr], seconds: float) -> str:
@@ -153,6 +163,18 @@ def _points(rng, n: int, box, samples: int) -> np.ndarray:
     integers = rng.integers(-10, 11, size=(samples, n)).astype(float)
     choice = rng.uniform(size=(samples, n))
     return np.where(choice < 0.5, normal, np.where(choice < 0.85, scaled, integers))
+
+
+def _kink_points(rng, n: int) -> np.ndarray:
+    """Points where sign, |.|, floor, fmod and copysign jump: the origin, and each coordinate in turn (four
+    drawn ones beyond four) at 0, +-1/2 and +-3/2 with the others N(0, 2^2): (1 + 3 min(n, 4), n)."""
+    rows = [np.zeros(n)]
+    for value in (0.0, 0.5, 1.5):
+        for i in (range(n) if n <= 4 else rng.choice(n, 4, replace=False)):
+            row = rng.normal(size=n) * 2.0
+            row[i] = value * rng.choice([-1.0, 1.0])
+            rows.append(row)
+    return np.array(rows)
 
 
 def _symbols(inputs, lhs, rhs) -> list[ca.SX]:
@@ -251,7 +273,10 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
 
     rng = np.random.default_rng(seed)
     worst, evaluated = 0.0, 0
-    for point in _points(rng, len(sym), box, samples):
+    points = _points(rng, len(sym), box, samples)
+    if box is None:
+        points = np.concatenate([points, _kink_points(rng, len(sym))])
+    for point in points:
         try:
             differences = relative(point, DIGITS)
         except (ZeroDivisionError, ValueError, TypeError, OverflowError):  # a pole or a domain edge: not a sample

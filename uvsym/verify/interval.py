@@ -20,7 +20,9 @@ x >= 0). Where it may not, the operation's bounds are the whole real line and th
 "undefined": never provable, and reported as such by the callers.
 
 ``smooth`` says, per box, whether no non-smooth operation (abs, min/max, comparisons,
-conditionals, sign, floor) has its kink inside the box; Taylor-type arguments need it.
+conditionals, sign, floor, ceil, fmod, copysign) has its kink inside the box; Taylor-type
+arguments need it. fmod is C's (the sign of the dividend), undefined where the divisor may be 0;
+copysign of a divisor box holding 0 takes either sign (C tells +0 from -0.0, the reals do not).
 """
 
 from __future__ import annotations
@@ -70,6 +72,8 @@ def _outside_domain(op: int, args) -> np.ndarray | None:
         return holds_zero(args[1])
     if op == ca.OP_INV:
         return holds_zero(a)
+    if op == ca.OP_FMOD:
+        return holds_zero(args[1])
     if op in (ca.OP_CONSTPOW, ca.OP_POW):
         exponent = float(args[1][0][0])
         if exponent == np.floor(exponent):
@@ -125,7 +129,7 @@ class IntervalFunction:
             ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST, ca.OP_ASSIGN, ca.OP_ADD, ca.OP_SUB, ca.OP_MUL, ca.OP_DIV,
             ca.OP_NEG, ca.OP_SQ, ca.OP_TWICE, ca.OP_INV, ca.OP_SIN, ca.OP_COS, ca.OP_COSH, ca.OP_FABS, ca.OP_SIGN,
             ca.OP_FMIN, ca.OP_FMAX, ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE, ca.OP_NOT, ca.OP_AND, ca.OP_OR,
-            ca.OP_IF_ELSE_ZERO, ca.OP_CONSTPOW, ca.OP_POW, ca.OP_FLOOR, ca.OP_CEIL}
+            ca.OP_IF_ELSE_ZERO, ca.OP_CONSTPOW, ca.OP_POW, ca.OP_FLOOR, ca.OP_CEIL, ca.OP_FMOD, ca.OP_COPYSIGN}
 
     def __call__(self, lo, hi) -> Intervals:
         """Bounds of the output over the boxes ``[lo, hi]`` (each (k, n) or (n,))."""
@@ -215,6 +219,14 @@ class IntervalFunction:
             function = np.floor if op == ca.OP_FLOOR else np.ceil
             lo, hi = function(a[0]), function(a[1])
             return (lo, hi), lo != hi
+        if op == ca.OP_COPYSIGN:  # |a| with b's sign; where b may be 0 (+0 or -0.0 in C) either sign
+            magnitude = (np.where(a[0] >= 0, a[0], np.where(a[1] <= 0, -a[1], 0.0)),
+                         np.maximum(np.abs(a[0]), np.abs(a[1])))
+            lo = np.where(b[0] > 0, magnitude[0], -magnitude[1])
+            hi = np.where(b[1] < 0, -magnitude[0], magnitude[1])
+            return (lo, hi), (b[0] <= 0) & (b[1] >= 0)
+        if op == ca.OP_FMOD:
+            return _fmod(a, b)
         if op in (ca.OP_FMIN, ca.OP_FMAX):
             pick = np.minimum if op == ca.OP_FMIN else np.maximum
             return (pick(a[0], b[0]), pick(a[1], b[1])), np.maximum(a[0], b[0]) <= np.minimum(a[1], b[1])
@@ -232,3 +244,18 @@ class IntervalFunction:
         lo = np.where(true, b[0], np.where(false, 0.0, np.minimum(b[0], 0.0)))
         hi = np.where(true, b[1], np.where(false, 0.0, np.maximum(b[1], 0.0)))
         return (lo, hi), ~true & ~false
+
+
+def _fmod(a, b):
+    """(lo, hi) of C's fmod(a, b) = a - b trunc(a / b) (boxes where b may be 0 are undefined: the
+    caller), and where trunc(a / b) may jump inside the box. Where trunc(a / b) is one integer q over
+    the box, a - q b with outward rounding; elsewhere the bounds every fmod obeys: the sign of a and
+    |fmod(a, b)| <= min(|a|, |b|)."""
+    q_lo, q_hi = div(a, b)
+    q_lo, q_hi = np.trunc(q_lo), np.trunc(q_hi)
+    one = (q_lo == q_hi) & np.isfinite(q_lo)
+    q = np.where(one, q_lo, 0.0)
+    exact = signed_sum(a, mul((q, q), b), -1.0)
+    bound = np.maximum(np.abs(b[0]), np.abs(b[1]))
+    loose = (np.where(a[0] >= 0, 0.0, np.maximum(a[0], -bound)), np.where(a[1] <= 0, 0.0, np.minimum(a[1], bound)))
+    return (np.where(one, exact[0], loose[0]), np.where(one, exact[1], loose[1])), ~one

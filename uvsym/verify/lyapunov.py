@@ -1,7 +1,10 @@
 """Quadratic Lyapunov certificates for linear error dynamics ``e' = A(theta) e``, A over a polytope.
 
-``lyapunov_decrease`` looks for ``P = P^T > 0`` with ``A_i^T P + P A_i + 2 gamma P <= 0`` at every
-vertex A_i (then ``V = e^T P e`` satisfies ``V' <= -2 gamma V`` for every A in the polytope) by an
+Every condition here is strict, and that is what is decided. ``lyapunov_decrease`` looks for
+``P = P^T > 0`` with ``A_i^T P + P A_i + 2 gamma P < 0`` (negative definite) at every vertex A_i
+(then ``V = e^T P e`` satisfies ``V' < -2 gamma V`` for every e != 0 and every A in the polytope:
+decay at a rate strictly above gamma; an eigenvalue on ``Re s = -gamma`` refutes it, as
+``A = diag(-1, -2)`` at ``gamma = 1``, where only the non-strict ``<= 0`` holds) by an
 LMI solved with cvxpy and Clarabel, then re-checks the answer without the solver: P is rounded to
 rationals and ``P`` and ``-(A_i^T P + P A_i + 2 gamma P)`` are shown positive definite by exact
 rational LDL^T factorisation (every pivot > 0). The margin is the smallest pivot ratio found.
@@ -88,7 +91,8 @@ def _eigen_witness(A: np.ndarray, by_modulus: bool) -> tuple[float, list[float]]
 
 def lyapunov_decrease(claim: str, vertices: list[np.ndarray], gamma: float, set_description: str,
                       expected: str = "proved") -> Certificate:
-    """Certificate that ``V = e^T P e`` decreases at rate ``2 gamma`` for every A in the hull of ``vertices``.
+    """Certificate that ``V = e^T P e`` decreases faster than at rate ``2 gamma`` (``V' < -2 gamma V``
+    for e != 0, the strict LMI of the module docstring) for every A in the hull of ``vertices``.
 
     vertices: non-empty list of (n, n) arrays or Fraction matrices; gamma: finite rate (1/s).
     VerificationError for a single matrix, non-finite entries or mismatched sizes.
@@ -131,7 +135,8 @@ def lyapunov_decrease(claim: str, vertices: list[np.ndarray], gamma: float, set_
         if not shifted_hurwitz(A_exact, gamma_exact):
             real, vector = _eigen_witness(A, by_modulus=False)
             return Certificate(claim, set_description, "Routh-Hurwitz on det(sI - A - gamma I) of a vertex, in exact "
-                               "rationals: an eigenvalue with real part >= -gamma", "refuted", expected,
+                               "rationals: an eigenvalue with real part >= -gamma (no P satisfies the strict LMI)",
+                               "refuted", expected,
                                margin=float(-gamma - real), seconds=time.perf_counter() - started,
                                counterexample={"A": A.tolist(), "gamma": gamma, "eigenvalue_real": real,
                                                "eigenvector_real": vector, "exact_test": "Routh-Hurwitz"})
@@ -146,8 +151,9 @@ def lyapunov_decrease(claim: str, vertices: list[np.ndarray], gamma: float, set_
 
 def discrete_lyapunov_decrease(claim: str, Ad: np.ndarray, rho: float, set_description: str,
                                expected: str = "proved") -> Certificate:
-    """Certificate that ``e_{k+1} = Ad e_k`` contracts at rate rho: ``V = e^T P e`` with
-    ``V_{k+1} <= rho^2 V_k``, i.e. ``P > 0`` and ``rho^2 P - Ad^T P Ad > 0`` (Stein inequality).
+    """Certificate that ``e_{k+1} = Ad e_k`` contracts faster than at rate rho: ``V = e^T P e`` with
+    ``V_{k+1} < rho^2 V_k`` for e != 0, i.e. ``P > 0`` and ``rho^2 P - Ad^T P Ad > 0`` (the strict
+    Stein inequality; an eigenvalue of modulus exactly rho refutes it).
 
     The spectral radius is first decided exactly (:func:`uvsym.verify.exact.schur`): radius >= rho
     refutes the claim. Then P solves ``(Ad / rho')^T P (Ad / rho') - P = -I`` (scipy) for rho'

@@ -4,7 +4,7 @@
 and evaluates every node with outward rounding at ``digits`` significant digits, so the exact real
 value of each expression at the point lies in the interval it returns. Functions mpmath's interval
 context lacks are built from identities that hold wherever the function is defined (``FUNCTIONS``);
-``Min``, ``Max``, ``sign`` and ``Piecewise`` are evaluated where the intervals decide them (a
+``Min``, ``Max``, ``sign``, ``floor``, ``ceiling`` and ``Piecewise`` are evaluated where the intervals decide them (a
 condition that the intervals cannot decide gives no enclosure). Anything else (an unknown function,
 a complex value, a domain edge) gives ``None``: no enclosure, never a guess.
 """
@@ -108,6 +108,10 @@ def _evaluator(point: dict):
         if isinstance(e, sp.sign):
             (a,) = args
             return _hull(-1 if a.a < 0 else 0 if a.a == 0 else 1, 1 if a.b > 0 else 0 if a.b == 0 else -1)
+        if isinstance(e, (sp.floor, sp.ceiling)):
+            (a,) = args
+            rounding = mpmath.floor if isinstance(e, sp.floor) else mpmath.ceil
+            return _hull(rounding(mpmath.mpf(a.a)), rounding(mpmath.mpf(a.b)))  # integers: exact
         if isinstance(e, sp.Piecewise):
             for expression, c in e.args:
                 if condition(c):
