@@ -11,7 +11,12 @@ that were neither decided nor checked), per kind as well:
 - ``region``: :func:`uvsym.verify.borderline.region_cases` through ``region_decrease``;
 - ``linear``: :func:`uvsym.verify.borderline.linear_cases`, each as a continuous
   (``lyapunov_decrease``) and a discrete (``discrete_lyapunov_decrease``) claim;
-- ``identity``: :func:`uvsym.verify.borderline.identity_cases` through ``prove_identity``.
+- ``identity``: :func:`uvsym.verify.borderline.identity_cases` through ``prove_identity``;
+- ``c_semantics``: :func:`uvsym.verify.borderline.c_semantics_cases` (fmod, copysign, floor, ceil,
+  sign, fmin/fmax, atan2 at their kinks) through ``prove_identity``, each verdict re-checked by
+  CasADi's own evaluation (:func:`~uvsym.verify.borderline.c_semantics_unsound`).
+
+``python benchmarks/soundness.py COUNT KIND`` runs one kind only, into ``soundness_<kind>.json``.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common import finish  # noqa: E402
 
-from uvsym.verify.borderline import identity_cases, linear_cases, region_cases
+from uvsym.verify.borderline import c_semantics_cases, c_semantics_unsound, identity_cases, linear_cases, region_cases
 from uvsym.verify.enclosure_check import BINARY, BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.identity import prove_identity
 from uvsym.verify.lyapunov import discrete_lyapunov_decrease, lyapunov_decrease
@@ -97,20 +102,42 @@ def identity_kind(count: int) -> dict:
     return result
 
 
-def main(count: int = 1000) -> dict:
-    kinds = {"interval": interval_kind(count, np.random.default_rng(100))}
-    print(f"interval: {kinds['interval']['cases']} cases, {kinds['interval']['unsound']} unsound", flush=True)
-    for name, run in (("region", region_kind), ("linear", linear_kind), ("identity", identity_kind)):
+def c_semantics_kind(count: int) -> dict:
+    started, outcomes, examples = time.perf_counter(), [], []
+    cases = c_semantics_cases(count, seed=104)
+    for case in cases:
+        certificate = prove_identity(case.kind, case.lhs, case.rhs, case.inputs, "the reals", symbolic_seconds=1.0)
+        why = c_semantics_unsound(case, certificate)
+        # a verdict the C check rejects is unsound whatever the generator's truth
+        outcomes.append(("missed" if why else certificate.status, case.holds))
+        examples += [why] if why else []
+    result = _tally(outcomes, time.perf_counter() - started, examples[:5])
+    result["by_class"] = {kind: {s: sum(1 for c, (st, _) in zip(cases, outcomes) if c.kind == kind and st == s)
+                                 for s in result["statuses"]} for kind in dict.fromkeys(c.kind for c in cases)}
+    return result
+
+
+KINDS = {"region": region_kind, "linear": linear_kind, "identity": identity_kind, "c_semantics": c_semantics_kind}
+
+
+def main(count: int = 1000, only: str | None = None) -> dict:
+    kinds = {} if only else {"interval": interval_kind(count, np.random.default_rng(100))}
+    if kinds:
+        print(f"interval: {kinds['interval']['cases']} cases, {kinds['interval']['unsound']} unsound", flush=True)
+    for name, run in KINDS.items():
+        if only and name != only:
+            continue
         kinds[name] = run(count)
         print(f"{name}: {kinds[name]['cases']} cases, {kinds[name]['unsound']} unsound, inconclusive rate "
               f"{kinds[name]['inconclusive_rate']:.3f}, {kinds[name]['seconds']} s", flush=True)
-    claims = [kinds[k] for k in ("region", "linear", "identity")]
+    claims = [kinds[k] for k in KINDS if k in kinds]
     results = {"cases": sum(k["cases"] for k in kinds.values()), "unsound": sum(k["unsound"] for k in kinds.values()),
                "inconclusive_rate": sum(k["statuses"].get("inconclusive", 0) for k in claims)
                / sum(k["cases"] for k in claims),
                "generated_per_kind": count, "kinds": kinds}
-    return finish(results, {"unsound_max": 0, "generated_per_kind_min": 1000}, RESULTS)
+    path = RESULTS if only is None else RESULTS.with_name(f"soundness_{only}.json")
+    return finish(results, {"unsound_max": 0, "generated_per_kind_min": 1000}, path)
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1000)
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1000, sys.argv[2] if len(sys.argv) > 2 else None)

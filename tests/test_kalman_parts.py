@@ -78,7 +78,7 @@ def test_each_covariance_is_named_with_the_filter_when_refused(which):
     given = {"Q": 1.0, "R": 1.0, "P0": 1.0, which: -1.0}
     with pytest.raises(CovarianceError) as info:
         checked_inputs(toy_plant(), "kf", 0.1, given["Q"], given["R"], given["P0"], None)
-    assert str(info.value).startswith(f"kf: {which} is not positive definite (smallest eigenvalue -1")
+    assert str(info.value).startswith(f"kf: {which} is indefinite (smallest eigenvalue -1")
 
 
 def test_an_initial_state_of_the_wrong_size_is_refused_naming_it():

@@ -88,10 +88,11 @@ def test_alpha_outside_the_unit_interval_is_refused(alpha):
         ukf(linear_plant(), dt=0.1, Q=Q, R=R, P0=P0, alpha=alpha)
 
 
-@pytest.mark.parametrize("argument, value", [("P0", np.diag([1.0, -1.0, 1.0])), ("Q", np.zeros((3, 3))),
+@pytest.mark.parametrize("argument, value", [("P0", np.diag([1.0, -1.0, 1.0])), ("Q", np.diag([0.0, 0.0, -1e-6])),
                                              ("R", np.array([[1.0, 2.0], [2.0, 1.0]])),
                                              ("R", np.array([[1.0, 0.5], [0.0, 1.0]])), ("Q", np.eye(2))])
-def test_covariances_that_are_not_positive_definite_are_refused(argument, value):
+def test_covariances_that_are_indefinite_or_malformed_are_refused(argument, value):
+    """Indefinite, not symmetric or of the wrong size (a semi-definite one, such as Q = 0, is a covariance)."""
     options = {"Q": Q, "R": R, "P0": P0, argument: value}
     with pytest.raises(CovarianceError, match=argument):
         ukf(linear_plant(), dt=0.1, **options)

@@ -21,6 +21,7 @@ from uvsym.observers.kalman import (
     cholesky,
     filter_observer,
     gaussian_loglik,
+    positive_definite,
     transition,
 )
 from uvsym.systems.system import System
@@ -33,6 +34,7 @@ def extended_filter(system: System, *, dt: float, Q, R, P0, x0=None, steps: int 
     """The EKF of ``system`` (module docstring) as a :class:`~uvsym.observers.kalman.GaussianFilter`;
     arguments and errors as :func:`uvsym.observers.ukf.unscented_filter` (no alpha, beta, kappa)."""
     Q, R, P0, x0 = checked_inputs(system, name, dt, Q, R, P0, x0)
+    semidefinite = not (positive_definite(Q) and positive_definite(P0))  # P may then lose rank (its margin)
     n = system.x.size
     F = transition(system, dt, steps)
     xs, us, ps = ca.SX.sym("x", n), ca.SX.sym("u", system.u.size), ca.SX.sym("p", system.p.size)
@@ -44,7 +46,7 @@ def extended_filter(system: System, *, dt: float, Q, R, P0, x0=None, steps: int 
     def predict(x, P, u, p):
         x_next, A, _, _ = model(x, u, p)
         P_next = ca.mtimes(ca.mtimes(A, P), A.T) + ca.DM(Q)
-        return x_next, P_next, cholesky(P_next)[1]
+        return x_next, P_next, cholesky(P_next, semidefinite)[1]
 
     def update(x, P, y, u, p):
         _, _, z, H = model(x, u, p)

@@ -36,11 +36,12 @@ from uvsym.symbolic import rk4
 from uvsym.systems.signals import Signals
 from uvsym.systems.system import System
 
-__all__ = ["GaussianFilter", "check_covariance", "checked_inputs", "cholesky", "cho_solve", "gaussian_loglik",
-           "transition", "packed", "unpacked", "covariance_signals", "measurement_gate", "initial_filter_state",
-           "filter_observer", "run_filter", "efficiency_augmented"]
+__all__ = ["GaussianFilter", "check_covariance", "positive_definite", "checked_inputs", "cholesky", "cho_solve",
+           "gaussian_loglik", "transition", "packed", "unpacked", "covariance_signals", "measurement_gate",
+           "initial_filter_state", "filter_observer", "run_filter", "efficiency_augmented"]
 
 JITTER = 1e-12  # relative: a_jj (1 + JITTER) on the diagonal before factorising
+SEMIDEFINITE = 1e-12  # relative to the largest diagonal entry: a pivot this small is a zero of a semi-definite P
 TINY = 1e-300
 LOG_2PI = float(np.log(2.0 * np.pi))
 BOUND = 1e100  # |entries| of a failed Cholesky pass are clipped here, so squares and sums stay finite
@@ -67,8 +68,9 @@ class GaussianFilter:
 
 
 def check_covariance(value, size: int, what: str) -> np.ndarray:
-    """A (size, size) symmetric positive definite matrix from ``value`` (a matrix, a vector of
-    variances or a scalar variance); CovarianceError naming ``what`` otherwise."""
+    """A (size, size) symmetric positive semi-definite matrix from ``value`` (a matrix, a vector of
+    variances or a scalar variance): its smallest eigenvalue at least ``-SEMIDEFINITE`` times its
+    largest absolute entry; CovarianceError naming ``what`` otherwise (an indefinite matrix)."""
     try:
         M = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -81,12 +83,20 @@ def check_covariance(value, size: int, what: str) -> np.ndarray:
         raise CovarianceError(f"{what} has non-finite entries")
     if np.max(np.abs(M - M.T)) > 1e-12 * max(1.0, float(np.max(np.abs(M)))):
         raise CovarianceError(f"{what} is not symmetric (max |M - M^T| = {np.max(np.abs(M - M.T)):.3g})")
+    smallest = float(np.min(np.linalg.eigvalsh(M)))
+    if smallest < -SEMIDEFINITE * max(float(np.max(np.abs(M))), TINY):
+        raise CovarianceError(f"{what} is indefinite (smallest eigenvalue {smallest:.6g}); a covariance is positive "
+                              "semi-definite")
+    return M
+
+
+def positive_definite(M: np.ndarray) -> bool:
+    """Whether a symmetric matrix is positive definite (its Cholesky factorisation succeeds)."""
     try:
         np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
-        raise CovarianceError(f"{what} is not positive definite (smallest eigenvalue "
-                              f"{float(np.min(np.linalg.eigvalsh(M))):.6g})") from None
-    return M
+        return False
+    return True
 
 
 def checked_inputs(system: System, name: str, dt: float, Q, R, P0, x0) -> tuple[np.ndarray, ...]:
@@ -105,7 +115,7 @@ def checked_inputs(system: System, name: str, dt: float, Q, R, P0, x0) -> tuple[
     return Q, R, P0, x0
 
 
-def cholesky(A) -> tuple[ca.SX, ca.SX]:
+def cholesky(A, semidefinite: bool = False) -> tuple[ca.SX, ca.SX]:
     """Lower factor L of ``sym(A) + JITTER diag(A)`` (SX, n <= ~10) and the smallest relative pivot
     ``min_j d_j / a_jj``, > 0 iff that matrix is positive definite (clipped below at -1).
 
@@ -113,19 +123,34 @@ def cholesky(A) -> tuple[ca.SX, ca.SX]:
     clipped to ``+-BOUND``, so that every output of a step stays finite at any finite input while
     the margin reports the failure (:func:`run_filter` raises on it). A positive definite
     matrix's factor is bounded by ``sqrt(a_ii)`` and never clipped.
+
+    semidefinite: a pivot within ``SEMIDEFINITE`` times the largest diagonal entry of 0 is a zero of
+    a positive semi-definite matrix: its column of L is 0 (so ``L L^T = A`` still) and it counts as
+    a pivot of 1 in the margin, which is then > 0 iff A is semi-definite (a zero pivot whose column
+    is not zero, or a negative pivot, shows an indefinite A).
     """
     A = 0.5 * (A + A.T)
     n = A.shape[0]
     L = [[ca.SX(0.0)] * n for _ in range(n)]
     margin = None
+    tolerance = SEMIDEFINITE * ca.fmax(ca.mmax(ca.diag(A)), TINY) if semidefinite else None
     for j in range(n):
         d = A[j, j] * (1.0 + JITTER) - sum((L[j][k] ** 2 for k in range(j)), ca.SX(0.0))
+        rest = [A[i, j] - sum((L[i][k] * L[j][k] for k in range(j)), ca.SX(0.0)) for i in range(j + 1, n)]
         relative = d / ca.fmax(A[j, j], TINY)
+        if semidefinite:  # a zero pivot: its column must vanish too (to the tolerance, scaled as a product)
+            zero = ca.fabs(d) <= tolerance
+            column = sum((ca.fabs(c) for c in rest), ca.SX(0.0))
+            relative = ca.if_else(zero, ca.if_else(column <= ca.sqrt(tolerance * ca.fmax(ca.mmax(ca.diag(A)), TINY)),
+                                                   1.0, -1.0), relative)
         margin = relative if margin is None else ca.fmin(margin, relative)
         L[j][j] = ca.sqrt(ca.fmax(d, TINY))
-        for i in range(j + 1, n):
-            L[i][j] = ca.fmin(ca.fmax((A[i, j] - sum((L[i][k] * L[j][k] for k in range(j)), ca.SX(0.0))) / L[j][j],
-                                      -BOUND), BOUND)
+        for i, c in zip(range(j + 1, n), rest):
+            L[i][j] = ca.fmin(ca.fmax(c / L[j][j], -BOUND), BOUND)
+        if semidefinite:
+            L[j][j] = ca.if_else(zero, 0.0, L[j][j])
+            for i in range(j + 1, n):
+                L[i][j] = ca.if_else(zero, 0.0, L[i][j])
     margin = ca.fmax(margin, -1.0)
     healthy = margin > 0.0
     factor = ca.SX(ca.Sparsity.lower(n))  # structural zeros above the diagonal: shifts along late columns

@@ -32,6 +32,7 @@ from uvsym.observers.kalman import (
     cholesky,
     filter_observer,
     gaussian_loglik,
+    positive_definite,
     transition,
 )
 from uvsym.systems.system import System
@@ -93,10 +94,14 @@ def unscented_filter(system: System, *, dt: float, Q, R, P0, x0=None, alpha: flo
     dt: sample period (s); Q (n, n) process and R (n_y, n_y) measurement noise covariances per
     sample, P0 (n, n) and x0 (n,) the prior at the first sample (matrices, variance vectors or
     scalars); steps: RK4 steps per sample of a continuous system; affine_closed_form: the update's
-    moments in closed form when h is affine in x (False: by sigma points all the same). CovarianceError for Q, R or P0
-    not symmetric positive definite; ObserverError for alpha outside (0, 1] and other bad input.
+    moments in closed form when h is affine in x (False: by sigma points all the same). Q, R and P0 may be
+    positive semi-definite (a discretised white-noise acceleration, a state known exactly): P's square
+    root is then a semi-definite factorisation (:func:`~uvsym.observers.kalman.cholesky`), and only the
+    innovation covariance must stay definite (pd_margin). CovarianceError for Q, R or P0 not symmetric
+    or indefinite; ObserverError for alpha outside (0, 1] and other bad input.
     """
     Q, R, P0, x0 = checked_inputs(system, name, dt, Q, R, P0, x0)
+    semidefinite = not (positive_definite(Q) and positive_definite(P0))  # P may then lose rank: factor it so
     n = system.x.size
     scale, w_m, w_c = unscented_weights(n, alpha, beta, kappa)
     F = transition(system, dt, steps)
@@ -105,7 +110,7 @@ def unscented_filter(system: System, *, dt: float, Q, R, P0, x0=None, alpha: flo
     back = np.argsort(order)
 
     def sigma_points(x, P):
-        L, margin = cholesky(P[order, order])
+        L, margin = cholesky(P[order, order], semidefinite)
         L = L[back, :]  # a square root of P: L L^T = P
         shifts = [scale * L[:, i] for i in range(n)]
         return [x] + [x + d for d in shifts] + [x - d for d in shifts], margin

@@ -26,6 +26,8 @@ Each case states a claim and whether it holds, decided independently of the veri
 
 from __future__ import annotations
 
+import itertools
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -34,7 +36,7 @@ import mpmath
 import numpy as np
 
 __all__ = ["IdentityCase", "LinearCase", "RegionCase", "c_semantics_cases", "identity_cases", "linear_cases",
-           "region_cases", "C_SEMANTICS"]
+           "region_cases", "C_GRID", "C_SEMANTICS", "c_semantics_unsound"]
 
 _TRANSCENDENTAL = {"sin": (ca.sin, mpmath.sin), "tanh": (ca.tanh, mpmath.tanh),
                    "expm1": (lambda x: ca.exp(x) - 1, mpmath.expm1)}
@@ -284,3 +286,30 @@ def c_semantics_cases(count: int, seed: int = 0) -> list[IdentityCase]:
         lhs, rhs = kinds[kind]
         cases.append(IdentityCase(kind, lhs, rhs, [x, y], holds))
     return cases
+
+
+C_GRID = tuple(v / 4 for v in range(-14, 15))  # dyadic: the operations of the generated claims are exact there
+
+
+def _c_differs(case: IdentityCase, point) -> bool:
+    """Whether CasADi's values (C semantics, no sympy) of the two sides differ at the point."""
+    a, b = (float(ca.Function("side", list(case.inputs), [e])(*point)) for e in (case.lhs, case.rhs))
+    return math.isfinite(a) and math.isfinite(b) and abs(a - b) > 1e-9 * (1 + abs(a) + abs(b))
+
+
+def c_semantics_unsound(case: IdentityCase, certificate) -> str | None:
+    """Why a verdict on a :func:`c_semantics_cases` claim is unsound, checked by CasADi's own evaluation
+    (C's semantics) alone, or None: a ``proved`` claim that is false by construction or differs somewhere
+    on the dyadic grid ``C_GRID`` squared, a ``refuted`` one that is true by construction or whose
+    counterexample does not differ."""
+    if certificate.status == "proved":
+        if not case.holds:
+            return f"{case.kind}: proved, false by construction"
+        wrong = [p for p in itertools.product(C_GRID, repeat=2) if _c_differs(case, p)]
+        return f"{case.kind}: proved, differs in C at {wrong[0]}" if wrong else None
+    if certificate.status == "refuted":
+        point = tuple(certificate.counterexample["point"].values())
+        if case.holds:
+            return f"{case.kind}: refuted at {point}, true by construction"
+        return None if _c_differs(case, point) else f"{case.kind}: refuted at {point}, where C gives equal sides"
+    return None

@@ -245,9 +245,14 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
     if outcome == "simplify":
         return certificate("sympy simplification to zero, rational constants (exact)", "proved")
     sym = [sp.Symbol(s.name(), real=True) for s in symbols]
-    numeric = sp.lambdify(sym, entries, modules="mpmath")
     sizes = [_magnitude(a) + _magnitude(b) for a, b in zip(left, right)]
-    magnitude = sp.lambdify(sym, sizes, modules="mpmath")
+    try:
+        numeric = sp.lambdify(sym, entries, modules="mpmath")
+        magnitude = sp.lambdify(sym, sizes, modules="mpmath")
+    except RecursionError:  # sympy's printer recurses once per level of nesting
+        return certificate("sampling by mpmath", "inconclusive",
+                           reason=f"{'not shown zero symbolically' if outcome == '' else 'symbolic steps timed out'}; "
+                                  "the difference is nested too deeply for sympy to print it for mpmath")
 
     def relative(point, digits):
         with mpmath.workdps(digits):
