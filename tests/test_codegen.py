@@ -206,3 +206,31 @@ int main(void) {
     *values, float_size = [float(v) for v in subprocess.run([str(exe)], capture_output=True, text=True).stdout.split()]
     assert values[:2] == pytest.approx([1.5, 2.0], rel=1e-15) and float_size == 4
     assert values[2:] == pytest.approx([2 * np.sin(0.5), 2 * np.sin(1.0)], rel=1e-6)  # single precision
+
+
+def test_a_filter_whose_covariance_is_indefinite_returns_unhealthy(tmp_path):
+    """The C status covers the estimator's health: pd_margin <= 0 (where Python's run_filter raises) returns
+    <NAME>_UNHEALTHY (4), a healthy step 0; the header and manifest say so."""
+    import json
+
+    from problems import double_integrator
+
+    from uvsym.codegen.estimators import exported_observer
+    from uvsym.observers.ukf import ukf
+
+    obs = ukf(double_integrator(outputs=("pos",)), dt=0.1, Q=np.diag([1e-4, 1e-2]), R=0.01, P0=np.eye(2))
+    exported = exported_observer(obs)
+    write_package(tmp_path, [exported], "filt", "double", "UKF of a double integrator")
+    header = (tmp_path / "include" / "filt.h").read_text()
+    assert "FILT_UNHEALTHY 4" in header and "FILT_NONFINITE_OUTPUT or FILT_UNHEALTHY." in header
+    assert json.loads((tmp_path / "manifest.json").read_text())["return_codes"]["FILT_UNHEALTHY"]["value"] == 4
+    exe = _build_harness(tmp_path, "filt", ["-O1"])
+    x, y, u, p = [0.5, -0.2], [0.4], [0.1], []
+    healthy, indefinite = [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]  # tril(P) column by column: P = diag(1, +-1)
+    codes, outputs, _ = _run(exe, [(0, [np.array(x + healthy), np.array(y), np.array(u), np.array(p)]),
+                                   (0, [np.array(x + indefinite), np.array(y), np.array(u), np.array(p)])])
+    margin = obs.publishes.index("pd_margin")
+    python = [np.asarray(obs.step(x + P, y, u, p)[1]).ravel()[margin] for P in (healthy, indefinite)]
+    assert python[0] > 0 >= python[1]
+    assert codes.tolist() == [0, 4]
+    assert outputs[1][len(x) + 3 + margin] == pytest.approx(python[1])

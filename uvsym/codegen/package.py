@@ -28,7 +28,9 @@ macro would leak): headers of packages of either precision go into one source fi
 buffers are static (sized by CasADi's ``*_SZ_*`` macros): nothing is allocated at run time, and
 the wrappers are not reentrant. With ``finite_check`` (the default) a wrapper refuses a NaN or infinite input entry
 (``<NAME>_NONFINITE_INPUT``, outputs untouched) and reports a non-finite output entry
-(``<NAME>_NONFINITE_OUTPUT``). The same functions and options give byte-identical files.
+(``<NAME>_NONFINITE_OUTPUT``). A function publishing ``pd_margin`` (a Gaussian filter, a bank)
+returns ``<NAME>_UNHEALTHY`` when it is not positive, the case in which the Python run raises
+CovarianceError. The same functions and options give byte-identical files.
 A double build matches the Python evaluation to 1e-12 relative; a float build (C only: it
 cannot be loaded through casadi.external) to 1e-5 of each call's largest output (tested).
 """
@@ -61,7 +63,11 @@ ERROR_CODES = (("OK", 0, "success: every output written"),
                ("EVAL_FAILED", 1, "CasADi's evaluation reported a failure"),
                ("NONFINITE_INPUT", 2, "an input entry is NaN or infinite (finite check on): nothing computed, "
                                       "outputs untouched"),
-               ("NONFINITE_OUTPUT", 3, "an output entry is NaN or infinite (finite check on): outputs written"))
+               ("NONFINITE_OUTPUT", 3, "an output entry is NaN or infinite (finite check on): outputs written"),
+               ("UNHEALTHY", 4, "an estimator's pd_margin output is not positive: a covariance it factorised is no "
+                                "longer positive definite (the Python run raises CovarianceError there); outputs "
+                                "written, not to be trusted"))
+HEALTH = "pd_margin"  # an output entry of this name must be > 0 (a Gaussian filter's or bank's health)
 
 
 @dataclass(frozen=True)
@@ -147,8 +153,11 @@ def _wrapper(e: Exported, package: str, finite_check: bool) -> tuple[str, str]:
              for i in range(f.n_out())]
     doc = [f"/* {e.description}", " *"]
     doc += [line for argument in e.arguments() for line in _doc_lines(*argument)]
-    returns = (f"{codes}_OK, {codes}_EVAL_FAILED, {codes}_NONFINITE_INPUT or {codes}_NONFINITE_OUTPUT"
-               if finite_check else f"{codes}_OK or {codes}_EVAL_FAILED")
+    health = _health_entries(e)
+    returned = [f"{codes}_OK", f"{codes}_EVAL_FAILED"] + ([f"{codes}_NONFINITE_INPUT", f"{codes}_NONFINITE_OUTPUT"]
+                                                          if finite_check else []) + ([f"{codes}_UNHEALTHY"] if health
+                                                                                      else [])
+    returns = ", ".join(returned[:-1]) + f" or {returned[-1]}"
     doc += [f" * Returns {returns}.", " * Uses static work buffers: not reentrant. */"]
     prototype = "\n".join(doc) + f"\nint {package}_{f.name()}({', '.join(args)});\n"
     inputs = ", ".join(f.name_in(i) for i in range(f.n_in()))
@@ -157,16 +166,24 @@ def _wrapper(e: Exported, package: str, finite_check: bool) -> tuple[str, str]:
                        for i in range(f.n_in()) if finite_check and f.nnz_in(i))
     check_out = "".join(f"\n  if (!{package}_all_finite({f.name_out(i)}, {f.nnz_out(i)})) "
                         f"return {codes}_NONFINITE_OUTPUT;" for i in range(f.n_out()) if finite_check and f.nnz_out(i))
+    check_health = "".join(f"\n  if (!({f.name_out(i)}[{j}] > 0)) return {codes}_UNHEALTHY;  /* {HEALTH} */"
+                           for i, j in health)
     body = f"""int {package}_{f.name()}({', '.join(args)}) {{
   static casadi_int iw[{name}_SZ_IW > 0 ? {name}_SZ_IW : 1];
   static casadi_real w[{name}_SZ_W > 0 ? {name}_SZ_W : 1];
   const casadi_real* arg[{name}_SZ_ARG > 0 ? {name}_SZ_ARG : 1] = {{{inputs}}};
   casadi_real* res[{name}_SZ_RES > 0 ? {name}_SZ_RES : 1] = {{{outputs}}};{check_in}
-  if ({name}(arg, res, iw, w, 0)) return {codes}_EVAL_FAILED;{check_out}
+  if ({name}(arg, res, iw, w, 0)) return {codes}_EVAL_FAILED;{check_out}{check_health}
   return {codes}_OK;
 }}
 """
     return prototype, body
+
+
+def _health_entries(e: Exported) -> list[tuple[int, int]]:
+    """(output, entry) of each output entry named ``HEALTH`` (documented entry by entry)."""
+    return [(i, j) for i, doc in enumerate(e.output_units) if isinstance(doc, Entries)
+            for j, entry in enumerate(doc.names) if entry == HEALTH]
 
 
 _ALL_FINITE = """/* 1 when the n entries of v are all finite (not NaN, not infinite), else 0 */
@@ -242,7 +259,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
         "casadi": ca.__version__, "finite_check": finite_check,
         "return_codes": {f"{name.upper()}_{suffix}": {"value": value, "meaning": meaning}
                          for suffix, value, meaning in ERROR_CODES
-                         if finite_check or "NONFINITE" not in suffix},
+                         if (finite_check or "NONFINITE" not in suffix)
+                         and (suffix != "UNHEALTHY" or any(_health_entries(e) for e in functions))},
         "example": None if example is None else {"function": f"{name}_{example.function}", "source": example.source},
         "functions": [{
             "name": e.function.name(), "c_function": f"{name}_{e.function.name()}",
