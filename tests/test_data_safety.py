@@ -2,6 +2,7 @@
 unless --force, existing result files unless overwrite/--force, and paths are checked before any work."""
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -204,3 +205,43 @@ def test_a_report_folder_is_checked_against_its_stamp(tmp_path, capsys):
     assert ("models holds files uvsym did not write (notes.txt) and files changed since uvsym wrote them "
             "(report.md)") in err
     assert (fresh / "report.md").read_text() == "# edited by hand\n" and (fresh / "notes.txt").read_text() == "keep"
+
+
+def _recorded(folder, **record):
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / ".build.json").write_text(json.dumps({**record, "files": {}}))
+    return folder
+
+
+def test_a_folders_record_says_which_command_wrote_it(tmp_path):
+    campaign = _recorded(tmp_path / "campaign", campaign="dc")
+    with pytest.raises(PathError, match="holds uvsym campaign's output for 'dc'; refusing to write the report"):
+        claim_folder(campaign, "the report", "report", writer=("derivation", "study"), accepts=("verify",))
+    with pytest.raises(PathError, match="holds the campaign 'dc'; refusing to write the campaign other"):
+        claim_folder(campaign, "the campaign other", "report", writer=("campaign", "other"))
+    assert claim_folder(campaign, "the campaign dc", "report", writer=("campaign", "dc")) == campaign
+    report = _recorded(tmp_path / "report", derivation="study")
+    with pytest.raises(PathError, match="holds uvsym report's output for 'study'; refusing to write the campaign"):
+        claim_folder(report, "the campaign dc", "report", writer=("campaign", "dc"))
+    proofs = _recorded(tmp_path / "proofs", verify="study")
+    assert claim_folder(proofs, "the report", "report", writer=("derivation", "study"), accepts=("verify",)) == proofs
+    assert claim_folder(campaign, "the report", "report", force=True, writer=("derivation", "study")) == campaign
+
+
+def test_a_dangling_symbolic_link_is_refused_as_an_output_folder(tmp_path):
+    (tmp_path / "link").symlink_to(tmp_path / "missing")
+    with pytest.raises(PathError, match=r"link is a symbolic link to .*missing, which does not exist"):
+        claim_folder(tmp_path / "link" / "sub", "the report", "report")
+    assert not (tmp_path / "missing").exists()
+
+
+def test_verify_keeps_a_foreign_proofs_file_and_lists_its_own(tmp_path, capsys):
+    source = str(Path(__file__).parents[1] / "examples" / "dc_motor" / "speed_sensor_bias.toml")
+    assert main(["verify", source, "--out", str(tmp_path)]) == 0
+    folder = next(p for p in tmp_path.iterdir() if p.is_dir())
+    assert json.loads((folder / ".build.json").read_text())["files"].keys() == {"proofs.json"}
+    assert main(["verify", source, "--out", str(tmp_path)]) == 0  # its own file, replaced
+    (folder / "proofs.json").write_text("[]\n")  # edited by hand: no longer what uvsym wrote
+    assert main(["verify", source, "--out", str(tmp_path)]) == 2
+    assert "changed since uvsym wrote them (proofs.json)" in capsys.readouterr().err
+    assert (folder / "proofs.json").read_text() == "[]\n"

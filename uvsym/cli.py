@@ -24,7 +24,7 @@ from uvsym.derivation import (
 )
 from uvsym.errors import UnknownNameError, UvsymError
 from uvsym.models import VEHICLES, vehicle
-from uvsym.paths import RECORDS, claim_folder, file_hashes, make_folder, output_folder
+from uvsym.paths import RECORDS, claim_folder, file_hashes, make_folder, output_folder, record_of
 from uvsym.systems.registry import PLANTS, plant, plant_names
 
 __all__ = ["BUILD_STAMP", "main"]
@@ -119,7 +119,8 @@ def _cmd_report(args) -> int:
 
     selected = _selected(args.names)
     out_root = output_folder(args.out, "reports")
-    out_dirs = [claim_folder(out_root / study.name, f"the {study.name} report", "report", args.force)
+    out_dirs = [claim_folder(out_root / study.name, f"the {study.name} report", "report", args.force,
+                             writer=("derivation", study.name), accepts=("verify",))
                 for study in selected]  # every folder checked, then made, before any study runs
     for out_dir in out_dirs:
         make_folder(out_dir, "a report")
@@ -364,13 +365,21 @@ def _cmd_verify(args) -> int:
     studies = [n for n in args.names if not _is_scenario_file(n)]
     everything, failures = [], 0
 
-    def record(name: str, certificates, seconds: float, notes=()) -> None:
+    def claimed(name: str) -> Path:
+        """NAME's folder for proofs.json, checked before its claims are computed: new, or uvsym's report or
+        proofs of NAME (proofs.json as uvsym wrote it), else PathError unless --force."""
+        return claim_folder(output_folder(args.out, "proofs") / name, f"the proofs of {name}", "report", args.force,
+                            writer=("verify", name), accepts=("derivation",))
+
+    def record(out_dir: Path, name: str, certificates, seconds: float, notes=()) -> None:
         nonlocal failures
         rows = [c.to_dict() for c in certificates]
         failures += sum(not c.as_expected for c in certificates)
-        out_dir = output_folder(args.out, "proofs") / name
-        out_dir.mkdir(parents=True, exist_ok=True)
+        make_folder(out_dir, f"the proofs of {name}")
         write_json(out_dir / "proofs.json", [{**row, "seconds": round(row["seconds"], 3)} for row in rows])
+        folder_record = record_of(out_dir, "report") or {"verify": name}  # proofs.json listed as uvsym's
+        folder_record["files"] = {**(folder_record.get("files") or {}), **file_hashes(out_dir, skip=BUILD_STAMP)}
+        (out_dir / BUILD_STAMP).write_text(json.dumps(folder_record) + "\n")
         everything.extend({"derivation": name, **row} for row in rows)
         if not args.json:
             print(f"{name}: {len(rows)} claims in {seconds:.1f} s, written to\n  {out_dir / 'proofs.json'}")
@@ -378,16 +387,19 @@ def _cmd_verify(args) -> int:
             print("".join(f"   {note}\n" for note in notes))
 
     if studies or not scenario_files:
-        for study in (s for s in _selected(studies) if s.claims is not None):
+        chosen = [s for s in _selected(studies) if s.claims is not None]
+        folders = [claimed(study.name) for study in chosen]  # every folder checked before any claim runs
+        for study, out_dir in zip(chosen, folders):
             started = time.perf_counter()
-            record(study.name, study.claims(), time.perf_counter() - started)
+            record(out_dir, study.name, study.claims(), time.perf_counter() - started)
     for source in scenario_files:
         from uvsym.scenario_exports import scenario_claims
 
         started = time.perf_counter()
         scenario, table = _read_system_scenario(source, "verify")
+        out_dir = claimed(scenario.name)
         certificates, notes = scenario_claims(scenario, table)
-        record(scenario.name, certificates, time.perf_counter() - started, notes)
+        record(out_dir, scenario.name, certificates, time.perf_counter() - started, notes)
     if args.json:
         print(json.dumps(everything, indent=2))
     else:
@@ -511,6 +523,7 @@ def _parser() -> argparse.ArgumentParser:
                                                  "about its estimators); default: every derivation that makes claims")
     verify.add_argument("--json", action="store_true", help="print the claims as a JSON list")
     verify.add_argument("--out", default="reports", help="where proofs.json goes, beside the report (default reports)")
+    verify.add_argument("--force", action="store_true", help="write into a folder holding files uvsym did not write")
     verify.set_defaults(run=_cmd_verify)
     return parser
 

@@ -18,13 +18,17 @@ from pathlib import Path
 
 from uvsym.errors import PathError, UvsymError
 
-__all__ = ["output_folder", "claim_folder", "make_folder", "output_file", "OWNERS", "RECORDS", "file_hashes",
-           "recorded_files", "write_files", "remove_stale"]
+__all__ = ["output_folder", "claim_folder", "make_folder", "output_file", "OWNERS", "RECORDS", "WRITERS", "file_hashes",
+           "recorded_files", "record_of", "write_files", "remove_stale"]
 
 
 def output_folder(path, what: str, error: type[UvsymError] = UvsymError) -> Path:
     """``path`` as a Path, ``error`` naming it when it, or the nearest existing parent, is a file."""
     folder = Path(path)
+    for link in (folder, *folder.parents):
+        if link.is_symlink() and not link.exists():
+            raise error(f"cannot write {what} into {folder}: {link} is a symbolic link to {os.readlink(link)}, "
+                        "which does not exist")
     existing = next((q for q in (folder, *folder.parents) if q.exists()), None)
     if existing is not None and not existing.is_dir():
         raise error(f"cannot write {what} into {folder}: {existing} is a file, not a folder")
@@ -110,14 +114,21 @@ def _listing(names: list[str]) -> str:
     return ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
 
 
-def claim_folder(path, what: str, owner: str, force: bool = False, built: tuple[str, ...] = ()) -> Path:
+def claim_folder(path, what: str, owner: str, force: bool = False, built: tuple[str, ...] = (),
+                 writer: tuple[str, str] | None = None, accepts: tuple[str, ...] = ()) -> Path:
     """The folder ``path`` for ``what`` (not made here); PathError naming the files when it holds
     files that are not uvsym's own ``owner`` output, or that changed since uvsym wrote them (module
     docstring), unless ``force``, or is not a writable folder. ``built``: relative paths that the
-    output's own build files write (a C package's ``make`` products), taken as uvsym's."""
+    output's own build files write (a C package's ``make`` products), taken as uvsym's.
+
+    writer: (command, name) of what writes the folder, e.g. ``("campaign", "dc-motor")``; a record
+    says which command wrote the folder (its key among :data:`WRITERS`), and a folder another command
+    wrote (unless its command is in ``accepts``), or another campaign, is refused too."""
     folder = output_folder(path, what, PathError)
     if not folder.is_dir() or force:
         return folder
+    if writer is not None:
+        _check_writer(folder, owner, what, writer, accepts)
     files = recorded_files(folder, owner)
     if files is None:  # no list of files: today's rule
         others = [] if OWNERS[owner](folder) else sorted(p.name for p in folder.iterdir())
@@ -132,6 +143,35 @@ def claim_folder(path, what: str, owner: str, force: bool = False, built: tuple[
         raise PathError(f"{folder} holds {' and '.join(problems)}; refusing to write {what} over them: "
                         "choose a new or empty folder, or pass --force to overwrite")
     return folder
+
+
+# the key of a folder's record -> the command that wrote the folder (its value: what it wrote)
+WRITERS = {"derivation": "uvsym report", "campaign": "uvsym campaign", "verify": "uvsym verify"}
+
+
+def record_of(folder, owner: str) -> dict | None:
+    """The JSON object of ``folder``'s ``owner`` record, or None."""
+    try:
+        record = json.loads((Path(folder) / RECORDS[owner]).read_text())
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
+
+
+def _check_writer(folder: Path, owner: str, what: str, writer: tuple[str, str], accepts: tuple[str, ...]) -> None:
+    """PathError when the folder's record says another command wrote it, or another output of the same name."""
+    record = record_of(folder, owner)
+    if record is None:
+        return
+    command, name = writer
+    found = [key for key in WRITERS if key in record]
+    if found and command not in found and not set(found) & set(accepts):
+        key = found[0]
+        raise PathError(f"{folder} holds {WRITERS[key]}'s output for {record[key]!r}; refusing to write {what} "
+                        "over it: choose another folder, or pass --force to overwrite")
+    if command in found and command == "campaign" and record[command] != name:
+        raise PathError(f"{folder} holds the campaign {record[command]!r}; refusing to write {what} over it: "
+                        "choose another folder, or pass --force to overwrite")
 
 
 def make_folder(path, what: str) -> Path:

@@ -85,7 +85,7 @@ class ResultStore:
     def __init__(self, folder, name: str, force: bool = False):
         self.folder, self.name = Path(folder), name
         self._drop_partials()
-        claim_folder(self.folder, f"the campaign {name}", "report", force)
+        claim_folder(self.folder, f"the campaign {name}", "report", force, writer=("campaign", name))
         record = self._record()
         self.files = dict(record.get("files") or {}) if isinstance(record, dict) else {}
 
