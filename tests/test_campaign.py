@@ -79,6 +79,23 @@ def killer(scenario, result, events):
     if scenario.seed == 2:
         os._exit(3)
     return metrics(scenario, result, events)
+
+
+def shadowing(scenario, result, events):
+    return {"seed": 0}
+
+
+def huge(scenario, result, events):
+    return {"count": 2 ** 64}
+
+
+def flaky(scenario, result, events):
+    """Kills its worker the first time it runs seed 2 (a marker file remembers), runs normally after."""
+    marker = LOG.with_name("died.marker")
+    if scenario.seed == 2 and not marker.exists():
+        marker.write_text("died")
+        os._exit(9)
+    return metrics(scenario, result, events)
 '''
 
 
@@ -398,13 +415,49 @@ def test_a_killed_driver_resumes_without_redoing_finished_runs(tmp_path):
     assert len(executed) <= 4 + 1  # at most the run in flight at the kill ran twice
 
 
+def test_a_campaign_killed_before_its_first_chunk_resumes(tmp_path):
+    path = _tiny(tmp_path, "slow", seeds=(1, 2))
+    out = tmp_path / "out"
+    driver = subprocess.Popen([sys.executable, "-m", "uvsym.cli", "campaign", str(path), "--out", str(out)],
+                              start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not (out / ".build.json").exists() and driver.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    os.killpg(driver.pid, signal.SIGKILL)
+    driver.wait()
+    assert (out / ".build.json").exists() and not list(out.glob("chunks/chunk-*.parquet"))
+    assert main(["campaign", str(path), "--out", str(out)]) == 0
+    assert [r["status"] for r in pq.read_table(out / "results.parquet").to_pylist()] == ["ok", "ok"]
+
+
 def test_a_worker_that_dies_gives_an_error_row_and_the_others_finish(tmp_path):
+    from uvsym.campaign.executors import RETRIES
+
     campaign = load_campaign(_tiny(tmp_path, "killer", seeds=(1, 2, 3)))
     rows = run_campaign(campaign, tmp_path / "out").to_pylist()
     assert [r["status"] for r in rows] == ["ok", "error", "ok"]
     assert rows[1]["error"].startswith("WorkerDied") and "exit code 3" in rows[1]["error"]
+    assert f"{RETRIES + 1} times" in rows[1]["error"]  # tried again in new processes first
     assert rows[1]["true_actuator"] == "X"  # truth is known without the run
     assert sorted(_executed(tmp_path)) == [1, 3]
+
+
+def test_a_run_whose_worker_died_once_is_tried_again_in_a_new_process(tmp_path):
+    campaign = load_campaign(_tiny(tmp_path, "flaky", seeds=(1, 2, 3)))
+    rows = run_campaign(campaign, tmp_path / "out").to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "ok", "ok"]
+    assert sorted(_executed(tmp_path)) == [1, 2, 3]
+
+
+def test_a_rerun_tries_the_runs_whose_worker_was_lost_again(tmp_path):
+    path = _tiny(tmp_path, "killer", seeds=(1, 2))
+    out = tmp_path / "out"
+    assert [r["status"] for r in run_campaign(load_campaign(path), out).to_pylist()] == ["ok", "error"]
+    hooks = next(tmp_path.glob("hooks_*.py"))  # the cause fixed: the hook no longer kills its worker
+    hooks.write_text(hooks.read_text().replace("os._exit(3)", "pass"))
+    rows = run_campaign(load_campaign(path), out).to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    assert sorted(_executed(tmp_path)) == [1, 2]  # seed 1 not redone
 
 
 def test_a_dask_worker_killed_under_a_chunk_has_the_chunk_rerun_run_by_run(tmp_path):
@@ -442,3 +495,17 @@ def test_a_study_scenario_is_found_by_name(tmp_path):
     assert [r.scenario["plant"] for r in campaign.runs] == ["rov_yaw", "rov_yaw"]
     with pytest.raises(CampaignError, match=r"no shipped scenario 'compass_11deg'; shipped: .*compass_10deg"):
         load_campaign(_write(tmp_path, text.replace("compass_10deg", "compass_11deg")))
+
+
+def test_values_a_results_table_cannot_hold_are_refused_before_any_run(tmp_path):
+    with pytest.raises(CampaignError, match=r"seed = 9223372036854775808 holds an integer beyond 64 bits"):
+        load_campaign(_tiny(tmp_path, seeds=(1, 2 ** 63)))
+    assert load_campaign(_tiny(tmp_path, seeds=(1, 2 ** 63 - 1))).runs[1].fields["seed"] == 2 ** 63 - 1
+
+
+@pytest.mark.parametrize("hook, message", [("shadowing", "the column 'seed', which is not a new column name"),
+                                           ("huge", "column 'count': expected a number (an integer within 64 bits)")])
+def test_a_hook_column_cannot_shadow_a_field_or_overflow_the_table(tmp_path, hook, message):
+    rows = run_campaign(load_campaign(_tiny(tmp_path, hook, seeds=(1,))), tmp_path / "out").to_pylist()
+    assert rows[0]["status"] == "error" and message in rows[0]["error"]
+    assert rows[0]["seed"] == 1  # the field kept

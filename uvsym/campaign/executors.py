@@ -6,7 +6,8 @@ each chunk completes (its rows in the chunk's order). ``start()`` connects, befo
 ``close()`` releases the workers.
 
 :class:`LocalExecutor` hands one run at a time to each of its processes; a process that dies
-during a run gives that run an error row and is replaced, so the other runs go on.
+during a run is replaced, and the run tried again in a new one, ``RETRIES`` times; then it gets
+an error row (``WorkerDied``: a rerun of the campaign tries it again), and the other runs go on.
 :class:`DaskExecutor` submits one task per chunk to the scheduler at ``scheduler`` (or to a
 ``LocalCluster`` it starts when none is given); a chunk whose task fails (a worker killed) is
 resubmitted run by run, one after the other, and a run that fails alone gets an error row.
@@ -23,7 +24,9 @@ from multiprocessing.connection import wait
 from uvsym.campaign import worker
 from uvsym.errors import ExecutorError
 
-__all__ = ["LocalExecutor", "DaskExecutor", "make_executor", "default_workers"]
+__all__ = ["LocalExecutor", "DaskExecutor", "make_executor", "default_workers", "RETRIES"]
+
+RETRIES = 2  # a run whose worker process dies is tried this many more times before its error row
 
 
 def default_workers() -> int:
@@ -84,6 +87,7 @@ class LocalExecutor:
         idle = [self._spawn(settings) for _ in range(min(self.workers, len(pending)))]
         busy: dict = {}  # (process, conn) -> (chunk index, run)
         lost = 0  # processes found dead while idle
+        deaths: dict[str, int] = {}  # run id -> worker processes that died under it
         try:
             while pending or busy:
                 while idle and pending:
@@ -109,14 +113,21 @@ class LocalExecutor:
                             row = conn.recv()
                     except (EOFError, OSError):
                         pass
-                    if row is None:  # the process died during the run
+                    if row is None:  # the process died during the run: replaced, the run tried again
                         process.join(5.0)
-                        row = worker.failure_row(run, f"WorkerDied: the worker process ended (exit code "
-                                                      f"{process.exitcode}) during this run")
                         conn.close()
                         self._processes.remove(slot)
+                        deaths[run.id] = deaths.get(run.id, 0) + 1
+                        if deaths[run.id] <= RETRIES:
+                            pending.appendleft((index, run))
+                        else:
+                            row = worker.failure_row(run, f"WorkerDied: the worker process ended (exit code "
+                                                          f"{process.exitcode}) during this run, "
+                                                          f"{deaths[run.id]} times")
                         if pending:
                             idle.append(self._spawn(settings))
+                        if row is None:
+                            continue
                     else:
                         idle.append(slot)
                     rows[index][run.id] = row

@@ -41,7 +41,7 @@ from uvsym.sim.fields import Fields
 from uvsym.sim.scenario import every_shipped_scenario, read_scenario_file
 from uvsym.sim.system_scenario import is_system_scenario, parse_any_scenario
 
-__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS"]
+__all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS", "storable"]
 
 DISTRIBUTIONS = ("uniform", "normal", "integers", "choice")
 EXECUTORS = ("local", "dask")
@@ -351,9 +351,29 @@ def _expand(spec: dict) -> list[Run]:
     return runs
 
 
+INT64 = (-2 ** 63, 2 ** 63 - 1)  # what a results table's integer column holds
+
+
+def storable(value) -> bool:
+    """Whether a results table can hold ``value`` (every integer in it within 64 bits, recursively)."""
+    if isinstance(value, bool) or value is None:
+        return True
+    if isinstance(value, int):
+        return INT64[0] <= value <= INT64[1]
+    if isinstance(value, (list, tuple)):
+        return all(storable(v) for v in value)
+    if isinstance(value, dict):
+        return all(storable(v) for v in value.values())
+    return True
+
+
 def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str, made=()) -> Run:
     """The parsed run; made: list entries (``faults[1]``) the case's paths add to its scenario (named
     in an error that is about one of them)."""
+    huge = [column for column, value in fields.items() if not storable(value)]
+    if huge:
+        raise CampaignError(f"case {case!r}, run {_describe(fields)}: {huge[0]} = {fields[huge[0]]!r:.40} holds an "
+                            "integer beyond 64 bits, which the results table cannot store")
     try:
         parse_any_scenario(table, default_name=scenario_name)
     except UvsymError as exc:

@@ -3,9 +3,9 @@
 ``OUT/chunks/chunk-<hash>.parquet`` holds the rows of one chunk. A chunk is written to a
 ``.part`` file and renamed, after the folder's record (``.build.json``, as for reports: every file
 uvsym wrote with its SHA-256, see :mod:`uvsym.paths`) lists it, so a campaign killed at any moment
-leaves only whole chunks, which a rerun skips; leftover ``.part`` files of a campaign folder are
-removed. The folder is claimed with :func:`uvsym.paths.claim_folder`: one holding files uvsym
-did not write is refused unless ``force``.
+leaves only whole chunks, which a rerun skips (but the runs whose worker process was lost, which it
+runs again); leftover ``.part`` files of a campaign folder are removed. The folder is claimed with
+:func:`uvsym.paths.claim_folder`: one holding files uvsym did not write is refused unless ``force``.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import pyarrow.csv
 import pyarrow.parquet as pq
 
 from uvsym.campaign.metrics import METRIC_COLUMNS
+from uvsym.campaign.worker import lost_worker
 from uvsym.errors import FileFormatError
 from uvsym.paths import RECORDS, claim_folder, file_hashes, make_folder
 
@@ -90,8 +91,10 @@ class ResultStore:
         self.files = dict(record.get("files") or {}) if isinstance(record, dict) else {}
 
     def create(self) -> None:
-        """Make the folder and its chunks/ (after every check, before the first run)."""
+        """Make the folder, its chunks/ and its record (after every check, before the first run: a campaign
+        stopped before its first chunk lands resumes, its folder being the campaign's own)."""
         make_folder(self.folder / "chunks", f"the campaign {self.name}")
+        self._save_record()
 
     def _record(self):
         try:
@@ -115,13 +118,16 @@ class ResultStore:
         return sorted((self.folder / "chunks").glob("chunk-*.parquet"))
 
     def finished(self) -> set[str]:
-        """The ids of the runs in whole chunk files."""
-        done = set()
+        """The ids of the runs in whole chunk files, but those whose only rows say their worker was lost
+        (:data:`~uvsym.campaign.worker.LOST_WORKER`): a rerun runs them again."""
+        done, lost = set(), set()
         for path in self.chunk_files():
             try:
-                done.update(pq.read_table(path, columns=["run_id"]).column("run_id").to_pylist())
+                table = pq.read_table(path, columns=["run_id", "error"])
             except (OSError, pa.ArrowException) as exc:
                 raise FileFormatError(f"{path}: not a campaign chunk uvsym wrote: {exc}") from None
+            for run_id, error in zip(table.column("run_id").to_pylist(), table.column("error").to_pylist()):
+                (lost if lost_worker(error) else done).add(run_id)
         return done
 
     def write_chunk(self, rows: list[dict], kinds: dict[str, str]) -> Path:
@@ -144,9 +150,10 @@ class ResultStore:
         if not tables:
             return to_table([], {})
         table = merge_tables(tables)
-        where = {}
-        for i, run_id in enumerate(table.column("run_id").to_pylist()):
-            where.setdefault(run_id, i)
+        where, errors = {}, table.column("error").to_pylist()
+        for i, run_id in enumerate(table.column("run_id").to_pylist()):  # a run's row, not its lost worker's
+            if run_id not in where or (lost_worker(errors[where[run_id]]) and not lost_worker(errors[i])):
+                where[run_id] = i
         return table.take([where[run_id] for run_id in run_ids if run_id in where])
 
     def write_results(self, table: pa.Table) -> None:

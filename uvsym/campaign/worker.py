@@ -13,10 +13,10 @@ import sys
 import time
 
 from uvsym.campaign.metrics import METRIC_COLUMNS, run_metrics, truth
-from uvsym.campaign.spec import Run, Settings
+from uvsym.campaign.spec import Run, Settings, storable
 from uvsym.errors import CampaignError
 
-__all__ = ["load_hook", "execute", "failure_row", "run_chunk", "serve"]
+__all__ = ["LOST_WORKER", "load_hook", "execute", "failure_row", "lost_worker", "run_chunk", "serve"]
 
 _SCALARS = (bool, int, float, str, type(None))
 
@@ -42,6 +42,14 @@ def _base(run: Run) -> dict:
     return {"run_id": run.id, "case": run.case, "draw": run.draw, **run.fields}
 
 
+LOST_WORKER = ("WorkerDied", "KilledWorker")  # errors that say the run's process was lost, not the run
+
+
+def lost_worker(error) -> bool:
+    """Whether an error row's message says the run's worker process was lost (killed, crashed under it)."""
+    return isinstance(error, str) and error.startswith(LOST_WORKER)
+
+
 def failure_row(run: Run, message: str) -> dict:
     """The error row of a run that gave no row of its own (e.g. its worker process died)."""
     from uvsym.sim.system_scenario import parse_any_scenario
@@ -63,7 +71,7 @@ def execute(run: Run, settings: Settings, hook=None) -> dict:
         events = list(getattr(result, "events", None) or [])
         row |= run_metrics(scenario, result, events)
         if hook is not None:
-            row |= _hook_columns(hook(scenario, result, events), settings.metrics)
+            row |= _hook_columns(hook(scenario, result, events), settings.metrics, row)
         row |= {"status": "ok", "error": None}
     except Exception as exc:  # a run that fails is a row, not the end of the campaign
         row |= {"status": "error", "error": f"{type(exc).__name__}: {exc}"}
@@ -71,15 +79,18 @@ def execute(run: Run, settings: Settings, hook=None) -> dict:
     return row
 
 
-def _hook_columns(columns, name: str) -> dict:
+def _hook_columns(columns, name: str, row: dict) -> dict:
+    """The hook's columns, checked: new names (not a metric, a field or another column of ``row``),
+    scalar values a results table can hold."""
     if not isinstance(columns, dict):
         raise CampaignError(f"metrics: {name} returned {type(columns).__name__}, not a dict of columns")
     for key, value in columns.items():
-        if not isinstance(key, str) or key in METRIC_COLUMNS:
-            raise CampaignError(f"metrics: {name} returned the column {key!r}, which is not a new column name")
-        if not isinstance(value, _SCALARS):
-            raise CampaignError(f"metrics: {name} column {key!r}: expected a number, string, bool or None, "
-                                f"got {type(value).__name__}")
+        if not isinstance(key, str) or key in METRIC_COLUMNS or key in row:
+            raise CampaignError(f"metrics: {name} returned the column {key!r}, which is not a new column name "
+                                "(a metric, a field or another column of the run has it)")
+        if not isinstance(value, _SCALARS) or not storable(value):
+            raise CampaignError(f"metrics: {name} column {key!r}: expected a number (an integer within 64 bits), "
+                                f"string, bool or None, got {value!r:.60}")
     return columns
 
 
