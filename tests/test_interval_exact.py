@@ -263,10 +263,28 @@ def test_indicators_of_decided_and_undecided_boxes():
 
 
 def test_quotients_of_several_boxes_are_bounded_box_by_box():
-    """[1, 2] / [1, 2] = [0.5, 2] and [1, 2] / [4, 8] = [0.125, 0.5] (exact in doubles, rounded out by one ulp)."""
-    lo, hi = ia.div((np.array([1.0, 1.0]), np.array([2.0, 2.0])), (np.array([1.0, 4.0]), np.array([2.0, 8.0])))
-    assert lo.tolist() == [0.5 - math.ulp(0.5) / 2, 0.125 - math.ulp(0.125) / 2]
-    assert hi.tolist() == [2.0 + math.ulp(2.0), 0.5 + math.ulp(0.5)]
+    """[1, 2] / [1, 2] = [0.5, 2] and [1, 2] / [4, 8] = [0.125, 0.5]: exact in doubles (TwoProduct shows
+    q y = x), so not widened; [1, 2] / [3, 3] = [1/3, 2/3] is not exact: rounded out by one ulp."""
+    lo, hi = ia.div((np.array([1.0, 1.0, 1.0]), np.array([2.0, 2.0, 2.0])),
+                    (np.array([1.0, 4.0, 3.0]), np.array([2.0, 8.0, 3.0])))
+    assert lo.tolist() == [0.5, 0.125, math.nextafter(1 / 3, 0)]
+    assert hi.tolist() == [2.0, 0.5, math.nextafter(2 / 3, 1)]
+
+
+def test_exact_products_and_quotients_stay_unwidened_and_inexact_ones_enclose():
+    """x / 0.5 and x * 2 are exact (an equilibrium stays exactly 0 after a division by L = 0.5); 0.1 * 3 is
+    not: its bounds hold the exact product of the doubles, checked in rationals."""
+    from fractions import Fraction
+
+    point = (np.array([3.0, 0.1]), np.array([3.0, 0.1]))
+    lo, hi = ia.div(point, (np.array([0.5, 0.5]), np.array([0.5, 0.5])))
+    assert lo.tolist() == hi.tolist() == [6.0, 0.2]
+    lo, hi = ia.mul(point, (np.array([2.0, 3.0]), np.array([2.0, 3.0])))
+    assert lo[0] == hi[0] == 6.0
+    assert Fraction(lo[1]) < Fraction(0.1) * 3 < Fraction(hi[1])
+    huge = (np.array([1e300]), np.array([1e300]))  # beyond the safe range: widened, never trusted exact
+    lo, hi = ia.mul(huge, (np.array([2.0 ** 10]), np.array([2.0 ** 10])))
+    assert lo[0] < 1e300 * 2 ** 10 < hi[0]
 
 
 def test_a_fractional_power_rounds_both_ends_out_by_the_library_ulps():

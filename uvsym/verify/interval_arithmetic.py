@@ -2,7 +2,8 @@
 
 Every rounded result moves outward by one unit in the last place (``numpy.nextafter``; library
 functions by ``LIBM_ULPS``), overflow included; results that are exact anyway (TwoSum-exact sums,
-2 x without overflow, products and quotients with an exact 0) stay unwidened. Integer powers go by
+2 x without overflow, TwoProduct-exact products and quotients, products and quotients with an exact
+0) stay unwidened. Integer powers go by
 repeated squaring, each step outward-rounded. :mod:`uvsym.verify.interval` replays a CasADi graph
 with these operations (and says where a box leaves an operation's domain).
 """
@@ -74,11 +75,43 @@ def signed_sum(a, b, sign: float):
     return clean(_rounded_sum(a[0], b_lo, -np.inf), _rounded_sum(a[1], b_hi, np.inf))
 
 
+_SPLIT = 2.0 ** 27 + 1.0  # Veltkamp's splitter: x = high + low, each with at most 26 significant bits
+_SAFE = (2.0 ** -480, 2.0 ** 480)  # magnitudes where the split and the error term neither overflow nor underflow
+
+
+def _product_exact(x, y, product):
+    """Where the float product ``x * y`` is exact: Dekker's TwoProduct error is 0, for factors (and a
+    product) of magnitude within ``_SAFE`` (elsewhere: not known exact)."""
+    with np.errstate(all="ignore"):
+        def split(v):
+            c = _SPLIT * v
+            high = c - (c - v)
+            return high, v - high
+
+        (xh, xl), (yh, yl) = split(x), split(y)
+        error = ((xh * yh - product) + xh * yl + xl * yh) + xl * yl
+        safe = np.ones_like(product, dtype=bool)
+        for v in (x, y, product):
+            safe &= (np.abs(v) >= _SAFE[0]) & (np.abs(v) <= _SAFE[1])
+    return safe & (error == 0)
+
+
+def _outward(candidates, exact):
+    """Bounds of the exact values of the float results ``candidates`` (4, k): a min and a max rounded
+    outward, but not an exact result."""
+    low = np.where(exact, candidates, round_down(candidates)).min(axis=0)
+    high = np.where(exact, candidates, round_up(candidates)).max(axis=0)
+    return low, high
+
+
 def mul(a, b):
-    with np.errstate(invalid="ignore"):
-        products = np.stack([a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]])
+    """a b, each of the four products rounded outward where it is not exact (TwoProduct)."""
+    pairs = [(a[0], b[0]), (a[0], b[1]), (a[1], b[0]), (a[1], b[1])]
+    with np.errstate(invalid="ignore", over="ignore"):
+        products = np.stack([x * y for x, y in pairs])
     products = np.where(np.isnan(products), 0.0, products)  # 0 * inf: a zero factor wins
-    return exact_zeros((round_down(products.min(axis=0)), round_up(products.max(axis=0))), a, b)
+    exact = np.stack([_product_exact(x, y, p) for (x, y), p in zip(pairs, products)])
+    return exact_zeros(_outward(products, exact), a, b)
 
 
 def holds_zero(b):
@@ -87,9 +120,12 @@ def holds_zero(b):
 
 def div(a, b):
     """a / b; where b holds 0 the box is undefined (the caller marks it) and the bounds unbounded."""
+    pairs = [(a[0], b[0]), (a[0], b[1]), (a[1], b[0]), (a[1], b[1])]
     with np.errstate(all="ignore"):
-        quotients = np.stack([a[0] / b[0], a[0] / b[1], a[1] / b[0], a[1] / b[1]])
-    bounds = clean(round_down(quotients.min(axis=0)), round_up(quotients.max(axis=0)))  # inf/inf: unbounded
+        quotients = np.stack([x / y for x, y in pairs])
+    # q = x / y is exact where q y is exactly x (TwoProduct): a division by a power of 2, or a multiple
+    exact = np.stack([_product_exact(q, y, q * y) & (q * y == x) for (x, y), q in zip(pairs, quotients)])
+    bounds = clean(*_outward(quotients, exact))  # inf/inf: unbounded
     lo, hi = exact_zeros(bounds, a)
     straddles = holds_zero(b)
     return np.where(straddles, -np.inf, lo), np.where(straddles, np.inf, hi)
