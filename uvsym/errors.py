@@ -28,6 +28,7 @@ __all__ = [
     "SetDivergenceError",
     "UIOConditionError",
     "StepSizeWarning",
+    "IntegrationAccuracyWarning",
     "CampaignError",
     "CampaignSizeError",
     "ExecutorError",
@@ -116,6 +117,11 @@ class FileFormatError(UvsymError, ValueError):
 
 class StepSizeWarning(UserWarning):
     """An adaptive filter's step size is at or beyond its stability bound (the message gives the bound)."""
+
+
+class IntegrationAccuracyWarning(UserWarning):
+    """The fast method's fixed-step RK4 misses its tolerance on sampled steps (the message gives the
+    substeps that would meet it)."""
 
 
 class SetError(UvsymError, ValueError):

@@ -36,6 +36,7 @@ from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.run import CHUNK, check_chunk, run_closed_loop
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import PreparedRun, observer_blocks, prepare_run, scenario_arguments
+from uvsym.sim.step_error import checked_steps
 
 __all__ = ["LANES", "simulate_batch", "run_lanes"]
 
@@ -108,8 +109,8 @@ def _system_lanes(scenarios: list, lanes: int, compiled: bool) -> list[SimResult
     from uvsym.sim.system_simulation import wired_meta
 
     runs = [PreparedRun(scenario.loop, scenario.z0, scenario_inputs(scenario), None,
-                        wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario)))
-            for scenario in scenarios]
+                        wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario)),
+                        scenario.rk4_tolerance) for scenario in scenarios]
     results = run_lanes(runs, lanes=lanes, compiled=compiled, names=[s.name for s in scenarios])
     return [decided(scenario, result) for scenario, result in zip(scenarios, results)]
 
@@ -179,12 +180,15 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool
         for lane, run in enumerate(group[:real]):  # views of the lane's own block: no copy per signal
             signals = {name: Signal(by_lane[lane, :, sl], labels, units)
                        for name, (sl, labels, units) in loop.signals.items()}
-            results.append(SimResult(run.W[:, 0].copy(), signals,
-                                     {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}))
+            meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}
+            if run.rk4_tolerance is not None and loop.plant_ode is not None:  # as the scalar path checks it
+                meta["rk4_error"] = checked_steps(loop, by_lane[lane], run.W, run.rk4_tolerance)
+            results.append(SimResult(run.W[:, 0].copy(), signals, meta))
     return results
 
 
 def _scalar(run: PreparedRun, compiled: bool) -> SimResult:
     """One run on the scalar fast path (the fallback of :func:`run_lanes`)."""
-    result, timing = run_closed_loop(run.loop, run.z0, run.W.copy(), compiled=compiled, guard=run.guard)
+    result, timing = run_closed_loop(run.loop, run.z0, run.W.copy(), compiled=compiled, guard=run.guard,
+                                     rk4_tolerance=run.rk4_tolerance)
     return SimResult(result.t, result.signals, {**run.meta, **timing})

@@ -45,6 +45,15 @@ class SampledLoop:
     correction_columns: slice | None = None
     substitution_columns: dict = field(default_factory=dict)
 
+    def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """(s (k, n_s), u_cmd (k, m)): the integrated plant state and the held plant inputs at the samples
+        of logged rows ``out`` (k, n_out), read back from what the loop logs (each loop says how); None
+        for a loop that does not say (its fast path's step error is then not checked)."""
+        return None
+
+    def _logged(self, out: np.ndarray, name: str) -> np.ndarray:
+        return out[:, self.signals[name][0]]
+
 
 def logged_signals(parts: dict[str, tuple]) -> tuple[ca.SX, dict]:
     """(out, name -> (slice of out, labels, units)) from name -> (expression, labels, units), in order."""

@@ -31,6 +31,7 @@ from uvsym.observers.ftc import Correction
 from uvsym.sim.integrator_options import checked_options
 from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
+from uvsym.sim.step_error import TOLERANCE, check_tolerance, checked_steps
 
 __all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop", "check_chunk", "check_memory",
            "memory_needed"]
@@ -69,14 +70,17 @@ class Supervisor(Protocol):
 
 def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
-                    compiled: bool = True, progress=None, guard=None) -> tuple[SimResult, dict]:
+                    compiled: bool = True, progress=None, guard=None,
+                    rk4_tolerance: float | None = TOLERANCE) -> tuple[SimResult, dict]:
     """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
 
     The decision columns of W are overwritten by the supervisor's decisions. ``guard(t, out)``
     (t: (k,) s, out: (k, n_out) logged rows) raises a typed error for samples outside the model's
     domain (e.g. a kinematic singularity); it sees every chunk, before the finiteness check, so the
     cause is named rather than its NaN. Returns the result (samples at every grid time, meta
-    without the caller's part) and timing information.
+    without the caller's part) and timing information, with the fast path's ``rk4_error`` on
+    sampled steps (:mod:`uvsym.sim.step_error`; an IntegrationAccuracyWarning past
+    ``rk4_tolerance``, None: not checked).
 
     Raises
     ------
@@ -100,6 +104,7 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     outputs = np.empty((N + 1, loop.discrete.size1_out("out")))
     advance, build_s = _stepper(loop, method, min(chunk, N), options, compiled)
     z = np.asarray(z0, dtype=float)
+    tolerance = check_tolerance(rk4_tolerance) if method == "fast" and loop.plant_ode is not None else None
     started = time.perf_counter()
     for start in range(0, N, chunk):
         k = min(chunk, N - start)
@@ -115,9 +120,12 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
             progress((start + k) / N)
     outputs[N] = np.asarray(loop.discrete(z, W[N])[2]).ravel()
     wall = time.perf_counter() - started
+    checked = checked_steps(loop, outputs, W, tolerance) if tolerance is not None else None
     # views of the one logged table (their columns are disjoint): no copy, half the memory
     signals = {name: Signal(outputs[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
+    if checked is not None:
+        timing["rk4_error"] = checked
     return SimResult(W[:, 0].copy(), signals, {}), timing
 
 

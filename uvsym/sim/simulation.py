@@ -23,6 +23,7 @@ from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
+from uvsym.sim.step_error import TOLERANCE
 
 __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observers", "current_profile", "PreparedRun",
            "prepare_run", "scenario_arguments"]
@@ -31,13 +32,15 @@ __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observe
 @dataclass(frozen=True)
 class PreparedRun:
     """A run of :func:`simulate` ready for the runner: its loop, initial state z0 (n_z,), per-sample
-    inputs W (N + 1, n_w), the attitude guard (None below 6 DOF) and the result's meta (no timings)."""
+    inputs W (N + 1, n_w), the attitude guard (None below 6 DOF), the result's meta (no timings) and
+    the fast path's step-error tolerance (None: not checked)."""
 
     loop: ClosedLoop
     z0: np.ndarray
     W: np.ndarray
     guard: Callable | None
     meta: dict
+    rk4_tolerance: float | None = TOLERANCE
 
 
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
@@ -45,7 +48,7 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
              actuator_faults: tuple[ActuatorFault, ...] = (), sensor_faults: tuple[SensorFault, ...] = (),
              observers: tuple[Observer, ...] = (), supervisor: Supervisor | None = None,
              method: str = "fast", substeps: int = 1, seed: int = 0, options: dict | None = None,
-             compiled: bool = True, progress=None) -> SimResult:
+             compiled: bool = True, progress=None, rk4_tolerance: float | None = TOLERANCE) -> SimResult:
     """Simulate ``model`` under ``controller`` for ``duration`` s, sampled every ``dt`` s.
 
     Parameters
@@ -60,6 +63,9 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
         integrator plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it,
         over the defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
     seed : seed of the standard normal draws behind sensor noise faults.
+    rk4_tolerance : the fast path's local error per sample, relative to each state's scale over the
+        run, checked by step doubling on sampled steps (:mod:`uvsym.sim.step_error`: an
+        IntegrationAccuracyWarning naming the substeps that would meet it; None: no check).
 
     Returns
     -------
@@ -72,7 +78,8 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
                       current=current, actuator_faults=actuator_faults, sensor_faults=sensor_faults,
                       observers=observers, method=method, substeps=substeps, seed=seed)
     result, timing = run_closed_loop(run.loop, run.z0, run.W, method=method, supervisor=supervisor, options=options,
-                                     compiled=compiled, progress=progress, guard=run.guard)
+                                     compiled=compiled, progress=progress, guard=run.guard,
+                                     rk4_tolerance=rk4_tolerance)
     return SimResult(result.t, result.signals, {**run.meta, **timing})
 
 

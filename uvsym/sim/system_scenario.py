@@ -5,7 +5,9 @@ names it (``blocks[1].decay``), with the close match of a misspelt key or name.
 Top-level fields: ``plant`` (a registered plant or vehicle, ``uvsym models``; or
 ``module:function`` returning a System, the module imported from ``plant_path``, default the
 scenario file's folder), ``[plant_parameters]`` (keyword arguments of the plant's builder),
-``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``seed`` (noise draws),
+``duration`` and ``step`` (s), ``substeps`` (RK4 steps per sample), ``rk4_tolerance`` (the fast
+path's local error per sample, relative to each state's scale, checked by step doubling on sampled
+steps, :mod:`uvsym.sim.step_error`; default 1e-4, false: not checked), ``seed`` (noise draws),
 ``[initial]`` (``x``: a list or a table of state = value; default the plant's operating point;
 ``d``: constant disturbances), ``[[disturbances]]`` (``signal`` = a disturbance name, ``times`` s,
 ``values``, ``interpolation`` "previous" or "linear": its schedule, sampled at every step and held
@@ -77,6 +79,7 @@ from uvsym.sim.fields import Fields
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Substitution
 from uvsym.sim.scenario import fault_tables
+from uvsym.sim.step_error import TOLERANCE
 from uvsym.sim.system_simulation import initial_state, loop_inputs
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
@@ -123,6 +126,7 @@ class SystemScenario:
     detectors: tuple
     substitutions: dict
     disturbance_noise: DisturbanceNoise | None = None
+    rk4_tolerance: float | None = TOLERANCE
 
     @property
     def input_labels(self) -> tuple[str, ...]:
@@ -209,6 +213,18 @@ def _user_plant(source: str, folder: str, overrides: dict) -> System:
     if not isinstance(built, System):
         raise ScenarioError(f"plant: {source} returned {type(built).__name__}, not a uvsym System")
     return built
+
+
+def _rk4_tolerance(top: Fields) -> float | None:
+    """``rk4_tolerance``: the fast path's step-error tolerance (:mod:`uvsym.sim.step_error`), or false."""
+    value = top.raw("rk4_tolerance", TOLERANCE, "number or false",
+                    "> 0: local error per sample checked by step doubling (relative to each state's scale); "
+                    "false: not checked")
+    if value is False:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (np.isfinite(value) and value > 0):
+        raise ScenarioError(f"rk4_tolerance: expected a positive number or false, got {value!r}")
+    return float(value)
 
 
 def _point(fields: Fields, key: str, group, default: np.ndarray) -> np.ndarray:
@@ -462,6 +478,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     if duration / step > 1e9:
         raise ScenarioError(f"duration: {duration:g} s at step {step:g} s is more than 1e9 samples")
     substeps = top.integer("substeps", 1, minimum=1, unit="RK4 steps per sample")
+    rk4_tolerance = _rk4_tolerance(top)
     seed = top.integer("seed", 0, unit="noise draws")
     initial = top.table("initial") or top.empty("initial")
     initial.describe("x", "list or table", "the plant's states: a list in order, or a table state = value",
@@ -536,7 +553,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
                           detectors=tuple(detectors), substitutions=by, disturbance_noise=DisturbanceNoise(
                               spread["noise"], spread["uniform_noise"],
                               (seed, 1) if disturbance_seed is None else disturbance_seed)
-                          if any(v.any() for v in spread.values()) else None)
+                          if any(v.any() for v in spread.values()) else None, rk4_tolerance=rk4_tolerance)
 
 
 
@@ -551,7 +568,7 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
 
     result = run_wired(scenario.loop, scenario.z0, scenario_inputs(scenario), method=method,
                        supervisor=scenario.supervisor, options=options, compiled=compiled, progress=progress,
-                       **scenario_meta_arguments(scenario))
+                       rk4_tolerance=scenario.rk4_tolerance, **scenario_meta_arguments(scenario))
     return decided(scenario, result)
 
 

@@ -9,6 +9,7 @@ from uvsym.faults import ActuatorFault, SensorFault, fault_parameters
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
+from uvsym.sim.step_error import TOLERANCE
 from uvsym.sim.wiring import WiredLoop, interconnect
 from uvsym.systems.system import System
 
@@ -36,7 +37,7 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
                     actuator_faults: tuple[ActuatorFault, ...] = (), sensor_faults: tuple[SensorFault, ...] = (),
                     substitutions: dict[str, str] | None = None, supervisor: Supervisor | None = None, d=None,
                     p=None, seed: int = 0, substeps: int = 1, options: dict | None = None, compiled: bool = True,
-                    progress=None) -> SimResult:
+                    progress=None, rk4_tolerance: float | None = TOLERANCE) -> SimResult:
     """Simulate ``plant`` in the loop with ``blocks`` (wired by :func:`uvsym.sim.wiring.interconnect`)
     for ``duration`` s, sampled every ``dt`` s.
 
@@ -50,6 +51,7 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     p : plant parameters (default ``plant.p0``); substitutions: channel -> substitute signal,
         switched by the supervisor's ``Substitution`` decisions (all off at the start).
     seed : seed of the standard normal draws behind sensor noise faults.
+    rk4_tolerance : the fast path's step-error tolerance (:func:`uvsym.sim.simulate`; None: no check).
 
     Returns
     -------
@@ -70,8 +72,7 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
     z0 = initial_state(loop, x0, W[0])
     return run_wired(loop, z0, W, method=method, supervisor=supervisor, options=options, compiled=compiled,
                      progress=progress, duration=duration, seed=seed, actuator_faults=actuator_faults,
-                     sensor_faults=sensor_faults,
-                     substitutions=substitutions)
+                     sensor_faults=sensor_faults, substitutions=substitutions, rk4_tolerance=rk4_tolerance)
 
 
 def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0) -> np.ndarray:
@@ -90,11 +91,11 @@ def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0) -> np.ndarray:
 def run_wired(loop: WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
               supervisor: Supervisor | None = None, options: dict | None = None, compiled: bool = True,
               progress=None, duration: float, seed: int = 0, actuator_faults=(), sensor_faults=(),
-              substitutions=None) -> SimResult:
+              substitutions=None, rk4_tolerance: float | None = TOLERANCE) -> SimResult:
     """Run a wired loop from z0 over the rows of W (:func:`loop_inputs`); the result of :func:`simulate_system`
     (the faults and substitutions given only describe the loop's own in the result's meta)."""
     result, timing = run_closed_loop(loop, z0, W, method=method, supervisor=supervisor, options=options,
-                                     compiled=compiled, progress=progress)
+                                     compiled=compiled, progress=progress, rk4_tolerance=rk4_tolerance)
     meta = wired_meta(loop, method=method, duration=duration, seed=seed, actuator_faults=actuator_faults,
                       sensor_faults=sensor_faults, substitutions=substitutions)
     return SimResult(result.t, result.signals, meta | timing)

@@ -86,6 +86,10 @@ class WiredLoop(SampledLoop):
     faults: tuple = ()
     fault_columns: slice = field(default_factory=lambda: slice(0, 0))
 
+    def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """s = x and the plant inputs as commanded (u less its actuator fault), per logged row."""
+        return self._logged(out, "x"), self._logged(out, "u") - self._logged(out, "fault_actuator")
+
 
 def _column(items) -> ca.SX:
     return ca.vertcat(*items) if items else ca.SX(0, 1)

@@ -124,7 +124,8 @@ def div(a, b):
     with np.errstate(all="ignore"):
         quotients = np.stack([x / y for x, y in pairs])
     # q = x / y is exact where q y is exactly x (TwoProduct): a division by a power of 2, or a multiple
-    exact = np.stack([_product_exact(q, y, q * y) & (q * y == x) for (x, y), q in zip(pairs, quotients)])
+    with np.errstate(all="ignore"):
+        exact = np.stack([_product_exact(q, y, q * y) & (q * y == x) for (x, y), q in zip(pairs, quotients)])
     bounds = clean(*_outward(quotients, exact))  # inf/inf: unbounded
     lo, hi = exact_zeros(bounds, a)
     straddles = holds_zero(b)

@@ -1,0 +1,135 @@
+"""The local error of the fast method's fixed-step RK4, estimated by step doubling on sampled steps.
+
+The fast path integrates the plant over each sample with ``substeps`` classical RK4 steps and no
+error control. After a run, at ``CHECKS`` of its samples -- the first ``EARLY``, the ``JUMPS``
+samples where the held plant input changes most (a set-point step, a saturating command, a fault
+switching on), and samples spread evenly -- the step ``s_k -> s_{k+1}`` is taken again from the
+run's own state (read back from its log, :meth:`~uvsym.sim.loop.SampledLoop.integrated`) with
+``substeps`` and with ``2 substeps`` RK4 steps; Richardson's estimate of the first one's error is
+``e = (s_n - s_2n) 16 / 15``. A step during which an actuator fault switches on or off is not
+checked: RK4's last stage there already sees the next sample's fault (the smear of
+:mod:`uvsym.sim.wiring`, at most one sample), which no number of substeps removes. Each entry's
+error is measured against the entry's scale over the run, ``tolerance (max_k |s_k,i|) + ATOL``, and
+the largest ratio is reported with the substeps that would meet the tolerance (the error over a
+sample falls as ``substeps^-4``). Sampled steps: numerical evidence, never a bound on every sample.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from uvsym.codegen.cache import memoized
+from uvsym.errors import IntegrationAccuracyWarning, SimulationError
+from uvsym.symbolic import rk4
+
+__all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance", "checked_steps", "state_name",
+           "step_error"]
+
+CHECKS, EARLY, JUMPS = 32, 4, 12
+TOLERANCE = 1e-4  # default: local error per sample, relative to each state entry's scale over the run
+ATOL = 1e-12  # absolute floor of every entry's scale (its unit)
+
+
+@dataclass(frozen=True)
+class StepError:
+    """The largest error ratio found (error over what the tolerance allows: > 1 fails), the sample time
+    t_s (s) and the integrated state entry (its index) where, and the substeps that would meet the
+    tolerance there; checked: how many steps were checked."""
+
+    ratio: float
+    t_s: float
+    entry: int
+    substeps_needed: int
+    checked: int
+
+    def as_dict(self) -> dict:
+        return {"largest_error_ratio": self.ratio, "at_s": self.t_s, "entry": self.entry,
+                "substeps_needed": self.substeps_needed, "steps_checked": self.checked}
+
+
+def check_tolerance(tolerance) -> float | None:
+    """The tolerance, checked: None (no check) or a positive finite number; SimulationError otherwise."""
+    if tolerance is None:
+        return None
+    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not (
+            math.isfinite(tolerance) and tolerance > 0):
+        raise SimulationError(f"rk4_tolerance must be a positive number (relative error per sample) or None, "
+                              f"got {tolerance!r}")
+    return float(tolerance)
+
+
+def check_indices(U: np.ndarray, switching: np.ndarray | None = None) -> list[int]:
+    """The samples k (< N, U (N + 1, m) the held inputs) whose step is checked (module docstring);
+    switching: (N,) True where an actuator fault switches on or off during step k (never checked)."""
+    N = len(U) - 1
+    if N < 1:
+        return []
+    scale = np.max(np.abs(U), axis=0) + 1e-300
+    change = np.max(np.abs(np.diff(U[:N], axis=0, prepend=U[:1])) / scale, axis=1) if U.shape[1] else np.zeros(N)
+    jumps = np.argsort(-change, kind="stable")[:JUMPS]
+    spread = np.linspace(0, N - 1, max(1, CHECKS - EARLY - JUMPS)).round().astype(int)
+    chosen = {*range(min(EARLY, N)), *(int(k) for k in jumps if change[k] > 0), *(int(k) for k in spread)}
+    return sorted(k for k in chosen if switching is None or not switching[k])
+
+
+@memoized(16)
+def _doubled(plant_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
+    """(s, u, env, t) -> [s after substeps RK4 steps; s after 2 substeps] over one sample of dt s."""
+    s, u = ca.SX.sym("s", plant_ode.size1_in(0)), ca.SX.sym("u", plant_ode.size1_in(1))
+    env, t = ca.SX.sym("env", plant_ode.size1_in(2)), ca.SX.sym("t")
+    coarse, fine = (rk4(plant_ode, s, dt, n, u, env, t=t) for n in (substeps, 2 * substeps))
+    return ca.Function("doubled", [s, u, env, t], [coarse, fine])
+
+
+def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> StepError | None:
+    """The largest error of the checked steps of a finished run (module docstring): outputs (N + 1, n_out)
+    its logged rows, W (N + 1, n_w) its inputs. None for a discrete-time plant, a loop that cannot read its
+    integrated state back, or a run of no step."""
+    if loop.plant_ode is None or len(W) < 2:
+        return None
+    read = loop.integrated(outputs)
+    if read is None:
+        return None
+    S, U = read
+    scale = tolerance * np.max(np.abs(S), axis=0) + ATOL
+    doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
+    faulty = loop._logged(outputs, "fault_actuator") != 0
+    ks = check_indices(U, np.any(faulty[1:] != faulty[:-1], axis=1) if faulty.shape[1] else None)
+    worst = (0.0, 0.0, 0)
+    for k in ks:
+        coarse, fine = (np.asarray(v).ravel() for v in doubled(S[k], U[k], W[k, loop.env_columns], W[k, 0]))
+        ratio = np.abs(coarse - fine) * (16.0 / 15.0) / scale
+        i = int(np.argmax(ratio))
+        if np.isfinite(ratio[i]) and ratio[i] > worst[0]:
+            worst = (float(ratio[i]), float(W[k, 0]), i)
+    ratio, t_s, entry = worst
+    needed = loop.substeps if ratio <= 1.0 else math.ceil(loop.substeps * ratio ** 0.25)
+    return StepError(ratio, t_s, entry, needed, len(ks))
+
+
+def state_name(loop, entry: int) -> str:
+    """The name of entry ``entry`` of a loop's integrated state s: a logged state's ``x.<label>``, else
+    the actuator state it is (the vehicle format's s = [x; a])."""
+    labels = loop.signals["x"][1] if "x" in loop.signals else ()
+    return f"x.{labels[entry]}" if entry < len(labels) else f"the integrated state s[{entry}] (an actuator)"
+
+
+def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> dict | None:
+    """The step error of a finished run (:func:`step_error`) as the result's ``rk4_error`` meta, with an
+    IntegrationAccuracyWarning (naming the state, the time and the substeps that would do) when it
+    misses the tolerance; None where nothing was checked."""
+    error = step_error(loop, outputs, W, tolerance)
+    if error is None:
+        return None
+    if error.ratio > 1.0:
+        warnings.warn(f"fast method: RK4 with {loop.substeps} substep(s) per {loop.dt:g} s sample misses the "
+                      f"tolerance {tolerance:g} by a factor {error.ratio:.3g} at t = {error.t_s:g} s in "
+                      f"{state_name(loop, error.entry)} (step doubling on {error.checked} sampled steps, the error "
+                      f"against the entry's largest value in the run); substeps = {error.substeps_needed} would "
+                      "meet it (or a CasADi integrator method)", IntegrationAccuracyWarning, stacklevel=4)
+    return error.as_dict() | {"tolerance": tolerance, "state": state_name(loop, error.entry)}
