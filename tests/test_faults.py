@@ -113,8 +113,15 @@ def test_loss_of_effectiveness_outside_0_1_is_refused(value):
 
 
 def test_bounds_and_finiteness_are_checked():
-    for value in (0.0, 1.0):
+    for value in (0.5, 1.0):
         ActuatorFault(0, "loss_of_effectiveness", value)
+    for kind, value in (("loss_of_effectiveness", 0.0), ("bias", 0.0), ("proportional", 1.0)):
+        with pytest.raises(FaultError, match=f"a {kind} actuator fault of {value!r} changes nothing"):
+            ActuatorFault(0, kind, value)
+    for kind in ("bias", "drift", "noise", "uniform_noise"):
+        with pytest.raises(FaultError, match=f"a {kind} sensor fault of 0 changes nothing"):
+            SensorFault(0, kind)
+    assert SensorFault(0, "stuck").value == 0.0  # stuck holds the last measurement: its value is not used
     for value in (math.nan, math.inf, "13"):
         with pytest.raises(FaultError, match="bias fault value must be a finite number"):
             ActuatorFault(0, "bias", value)

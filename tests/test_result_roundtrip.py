@@ -29,7 +29,9 @@ def results(draw):
                                tuple(draw(st.lists(TEXT, min_size=k, max_size=k))))
     meta = draw(st.dictionaries(TEXT, st.one_of(st.integers(-10**6, 10**6), TEXT,
                                                 st.floats(allow_nan=False, allow_infinity=False)), max_size=3))
-    return SimResult(draw(arrays(np.float64, (n,), elements=FLOATS)), signals, meta)
+    times = np.sort(draw(arrays(np.float64, (n,), elements=st.floats(allow_nan=False, allow_infinity=False,
+                                                                     width=64))))  # finite, never decreasing
+    return SimResult(times, signals, meta)
 
 
 def _assert_same(loaded: SimResult, original: SimResult) -> None:

@@ -114,7 +114,7 @@ def test_a_substitution_switches_from_the_flag_on(tmp_path):
     ({"durration": 2.0}, "durration: unknown field (did you mean 'duration'?)"),
     ({"noise": {"omega": 0.1}}, "noise.omega: unknown output or disturbance of dc_motor (did you mean 'omega_meas'?)"),
     ({"faults": [{"sensor": "omega", "kind": "bias", "value": 1.0}]}, "faults[0].sensor: unknown value 'omega'"),
-    ({"faults": [{"sensor": "omega_meas", "kind": "bias", "value": 0.0}]}, "faults[0].value: a bias fault of 0"),
+    ({"faults": [{"sensor": "omega_meas", "kind": "bias", "value": 0.0}]}, "faults[0].value: a bias sensor fault of 0"),
     ({"faults": [{"actuator": "V", "kind": "bias", "value": 1.0, "onset": 9.0}]}, "faults[0].onset: 9 s is outside"),
     ({"initial": {"x": {"omegaa": 1.0}}}, "initial.x.omegaa: unknown state (did you mean 'omega'?)"),
     ({"initial": {"x": [0.0, float("nan")]}}, "initial.x: entries must be finite"),

@@ -231,3 +231,50 @@ def test_a_wired_run_too_large_to_hold_is_refused_with_the_figures_before_alloca
         simulate_system(_spring(), [controller], duration=0.01 * samples, dt=0.01, x0=[0.0, 0.0])
     with pytest.raises(SimulationError, match=r"1e\+14 samples, more than 1e\+12"):
         simulate_system(_spring(), [controller], duration=1e12, dt=0.01, x0=[0.0, 0.0])
+
+
+def _cases_of_the_api():
+    """(call, error type, message) for bad arguments of the Python API a user meets first."""
+    from uvsym.errors import FaultError, ModelError, ObserverError, SimulationError, VerificationError
+    from uvsym.faults import SensorFault
+    from uvsym.observers import actuator_observer
+    from uvsym.observers.gains import design_gains
+    from uvsym.sim import lqr_gain, pid, simulate_system
+    from uvsym.sim.result import Signal, SimResult
+    from uvsym.systems import plant
+    from uvsym.systems.discretize import zoh_matrices
+    from uvsym.verify.uio import exact_zoh
+
+    rov = plant("rov_yaw")
+    heading = pid("c", measured="psi", reference=0.0, kp=1.0, output="u", dt=0.1)
+    row = Signal(np.zeros((2, 1)), ("a",), ("m",))
+    return [
+        (lambda: uvsym.vehicle("otter", rp=["a", "b", "c"]), ModelError, "parameter 'rp' must be a number or a list"),
+        (lambda: uvsym.vehicle("otter", mp={"a": 1}), ModelError, "parameter 'mp' must be a number or a list"),
+        (lambda: uvsym.vehicle("otter", mp=1e300), ModelError, r"cannot be built with mp=1e\+300"),
+        (lambda: plant("rov_yaw", m66=[1, "x"]), ModelError, "parameter 'm66' must be a number or a list"),
+        (lambda: rov.discretize("0.1"), ModelError, r"sample period dt \(s\) must be a finite number, got '0.1'"),
+        (lambda: pid("c", measured="psi", kp="5", output="u", dt=0.1), ModelError, "pid c: kp must be a finite"),
+        (lambda: pid("c", measured="psi", kp=5.0, output="u", dt=0.1, limits=(1.0,)), ModelError,
+         r"limits must be \(lo, hi\)"),
+        (lambda: simulate_system(rov, [heading], duration=1.0, dt=0.1, x0=[0, 0], seed=-1), SimulationError,
+         "seed must be an integer >= 0"),
+        (lambda: design_gains(actuator_observer(uvsym.vehicle("docking_auv"), "bias", "momentum"), 1e-300),
+         ObserverError, "time_constant 1e-300 s is outside"),
+        (lambda: lqr_gain(np.eye(2), np.ones((2, 1)), np.diag([1.0, -1.0]), np.eye(1)), ModelError,
+         "Q must be positive semi-definite"),
+        (lambda: lqr_gain(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((1, 1))), ModelError,
+         "R must be positive definite"),
+        (lambda: zoh_matrices(np.eye(2), np.ones((2, 1)), -1), ModelError, r"dt \(s\) must be positive"),
+        (lambda: exact_zoh(np.zeros((2, 2)), np.ones((2, 1)), -1), VerificationError, "dt must be positive"),
+        (lambda: SimResult(np.array([0.0, np.nan]), {"x": row}, {}), SimulationError, r"t must be finite"),
+        (lambda: SimResult(np.array([1.0, 0.0]), {"x": row}, {}), SimulationError, "never decreasing"),
+        (lambda: SensorFault(0, "bias"), FaultError, "a bias sensor fault of 0 changes nothing"),
+    ]
+
+
+@pytest.mark.parametrize("index", range(16))
+def test_bad_arguments_of_the_api_get_typed_errors_naming_them(index):
+    call, error, message = _cases_of_the_api()[index]
+    with pytest.raises(error, match=message):
+        call()

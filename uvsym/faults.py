@@ -245,6 +245,9 @@ class ActuatorFault:
     def __post_init__(self):
         _check_index_type(self.actuator, "actuator")
         self.kind_object.check(self.value)
+        healthy = self.kind_object.healthy
+        if isinstance(self.value, (int, float)) and healthy is not None and self.value == healthy:
+            raise FaultError(f"a {self.kind} actuator fault of {self.value!r} changes nothing (the healthy value)")
 
     @property
     def kind_object(self) -> ActuatorKind:
@@ -271,6 +274,9 @@ class SensorFault:
     def __post_init__(self):
         _check_index_type(self.channel, "channel")
         self.kind_object.check(self.value)
+        if isinstance(self.value, (int, float)) and self.value == 0 and self.kind != "stuck":
+            raise FaultError(f"a {self.kind} sensor fault of 0 changes nothing: give its value "
+                             f"({'per second' if self.kind == 'drift' else 'the output unit'})")
 
     @property
     def kind_object(self) -> SensorKind:

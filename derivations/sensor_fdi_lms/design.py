@@ -42,6 +42,7 @@ __all__ = ["Design", "design", "DT", "ORDER", "MU", "SET_POINT_DEG", "EPS0_DEG2"
 
 # the paper's numbers
 DT = 0.2  # s (L563)
+SUBSTEPS = 8  # RK4 steps of the plant per sample: 4 miss the fast path's step-error tolerance (1e-4) after a turn
 ORDER = 70  # M (L165-167)
 MU = 0.01  # LMS step, per unit of u squared (L183)
 SET_POINT_DEG = 150.0  # (L515)

@@ -24,6 +24,7 @@ from derivations.sensor_fdi_lms.design import (
     R0,
     RECORD,
     SET_POINT_DEG,
+    SUBSTEPS,
     WARM_UP,
     design,
     torque_table,
@@ -119,7 +120,7 @@ def run(spec: Run) -> Outcome:
                                   spec.profile_object()))
     result = simulate_system(plant, d.blocks, duration=samples * DT, dt=DT, x0=[math.radians(SET_POINT_DEG), 0.0],
                              sensor_faults=tuple(faults), d=torque_table(samples, spec.seed), seed=spec.seed,
-                             substeps=4, compiled=False)
+                             substeps=SUBSTEPS, compiled=False)
     supervisor = SubstitutionSupervisor(d.monitor, correct=False, substitute_on=spec.substitute_on)
     supervisor.update(result.t, {d.monitor.name: result[d.monitor.name].values})
     return Outcome(spec, result, supervisor)

@@ -33,6 +33,7 @@ from derivations.sensor_fdi_lms.design import (
     R0,
     RECORD,
     SET_POINT_DEG,
+    SUBSTEPS,
     WARM_UP,
     design,
     torque_table,
@@ -69,7 +70,7 @@ def _records(pulse: bool) -> tuple[np.ndarray, np.ndarray]:
     profile = Profile("step", onset=onset, end=onset + DT) if pulse else Profile("step", onset=onset)
     faults = (SensorFault(0, "noise", math.radians(COMPASS_NOISE_DEG)),
               SensorFault(0, "bias", math.radians(SIZE_DEG), profile))
-    loop = interconnect(plant, d.blocks, dt=DT, sensor_faults=faults, substeps=4)
+    loop = interconnect(plant, d.blocks, dt=DT, sensor_faults=faults, substeps=SUBSTEPS)
     roll = _roller(loop.step, WARM_UP + RECORD)
     names = d.monitor.publishes.names
     sl = loop.signals["lms"][0]

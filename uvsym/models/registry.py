@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from uvsym.errors import UnknownNameError
+from uvsym.errors import ModelError, UnknownNameError, UvsymError
 from uvsym.models.model import Model
 from uvsym.models.vehicles import docking_auv, otter, otter3dof, remus100, torpedo
 
@@ -42,7 +42,23 @@ def vehicle(name: str, **overrides) -> Model:
     """
     if name not in VEHICLES:
         raise UnknownNameError(f"unknown vehicle {name!r}; known vehicles: {', '.join(VEHICLES)}")
-    frozen = tuple(sorted((key, tuple(np.asarray(value, dtype=float).ravel().tolist())
-                           if isinstance(value, (list, tuple, np.ndarray)) else value)
-                          for key, value in overrides.items()))
-    return _build_cached(name, frozen)
+    frozen = tuple(sorted((key, frozen_override(name, key, value)) for key, value in overrides.items()))
+    try:
+        return _build_cached(name, frozen)
+    except UvsymError:
+        raise
+    except (ArithmeticError, ValueError, TypeError, np.linalg.LinAlgError) as exc:  # an override the equations
+        shown = ", ".join(f"{key}={value!r}" for key, value in overrides.items())  # cannot take (sqrt of < 0, ...)
+        raise ModelError(f"{name}: the model cannot be built with {shown}: {type(exc).__name__}: {exc}") from None
+
+
+def frozen_override(owner: str, key: str, value):
+    """An override as a hashable number or tuple of numbers; ModelError naming it when it is neither."""
+    if isinstance(value, (list, tuple, np.ndarray)):
+        try:
+            return tuple(np.asarray(value, dtype=float).ravel().tolist())
+        except (TypeError, ValueError):
+            pass
+    elif isinstance(value, (int, float, str, bool)) or value is None:
+        return value
+    raise ModelError(f"{owner}: parameter {key!r} must be a number or a list of numbers, got {value!r:.60}")

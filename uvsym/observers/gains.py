@@ -18,7 +18,9 @@ from uvsym.errors import ObserverError
 from uvsym.faults import actuator_kind
 from uvsym.observers.actuator import ActuatorObserver
 
-__all__ = ["GainDesign", "design_gains", "unobservable_channels"]
+__all__ = ["GainDesign", "design_gains", "unobservable_channels", "MIN_TIME_CONSTANT", "MAX_TIME_CONSTANT"]
+
+MIN_TIME_CONSTANT, MAX_TIME_CONSTANT = 1e-9, 1e9  # s: gains of 1e9 to 1e-9 per second at most
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,9 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
     if isinstance(time_constant, bool) or not isinstance(time_constant, (int, float, np.floating)) or \
             not time_constant > 0.0 or not np.isfinite(time_constant):
         raise ObserverError(f"time_constant must be positive and finite (s), got {time_constant!r}")
+    if not MIN_TIME_CONSTANT <= time_constant <= MAX_TIME_CONSTANT:
+        raise ObserverError(f"time_constant {time_constant!r} s is outside [{MIN_TIME_CONSTANT:g}, "
+                            f"{MAX_TIME_CONSTANT:g}] s: gains ~ 1 / time_constant would be meaningless in doubles")
     n = observer.function.size1_in("x")
     if tau_d is None:
         if actuator_kind(observer.kind).scales:

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.linalg import solve_continuous_are, solve_discrete_are
 
 from uvsym.errors import ModelError
+from uvsym.numbers import real
 from uvsym.sim.blocks import Block, as_signals, block
 from uvsym.systems.discretize import zoh_matrices
 from uvsym.systems.signals import Signals, signals
@@ -46,11 +47,14 @@ def pid(name: str, measured: str | Signals, reference: float | str = 0.0, *, out
     sensor, where that matters). Publishes u under ``output``; limits (lo, hi) in u's unit.
     """
     y_sig, u_sig = _one(measured, "measured"), _one(output, "output")
-    lo, hi = (-np.inf, np.inf) if limits is None else (float(limits[0]), float(limits[1]))
+    kp, ki, kd = (real(v, f"pid {name}: {k}", ModelError) for k, v in (("kp", kp), ("ki", ki), ("kd", kd)))
+    dt = real(dt, f"pid {name}: dt (s)", ModelError, positive=True)
+    if limits is not None and (not isinstance(limits, (list, tuple, np.ndarray)) or len(limits) != 2):
+        raise ModelError(f"pid {name}: limits must be (lo, hi) with lo < hi, got {limits!r}")
+    lo, hi = (-np.inf, np.inf) if limits is None else (real(limits[0], f"pid {name}: limits[0]", ModelError),
+                                                       real(limits[1], f"pid {name}: limits[1]", ModelError))
     if not lo < hi:
         raise ModelError(f"pid {name}: limits must be (lo, hi) with lo < hi, got {limits}")
-    if not all(np.isfinite([kp, ki, kd])):
-        raise ModelError(f"pid {name}: gains must be finite, got kp={kp}, ki={ki}, kd={kd}")
     unit = y_sig.units[0]
     reads = y_sig
     if isinstance(reference, str):
@@ -100,6 +104,12 @@ def lqr_gain(A, B, Q, R, dt: float | None = None) -> np.ndarray:
     n, m = B.shape
     if Q.shape != (n, n) or R.shape != (m, m):
         raise ModelError(f"LQR: Q must be ({n}, {n}) and R ({m}, {m}), got {Q.shape} and {R.shape}")
+    for what, M, least in (("Q", Q, "positive semi-definite"), ("R", R, "positive definite")):
+        if not np.all(np.isfinite(M)) or np.max(np.abs(M - M.T)) > 1e-12 * max(1.0, float(np.max(np.abs(M)))):
+            raise ModelError(f"LQR: {what} must be a finite symmetric matrix, got {M.tolist()}")
+        smallest = float(np.min(np.linalg.eigvalsh(0.5 * (M + M.T))))
+        if smallest < -1e-12 * max(1.0, float(np.max(np.abs(M)))) or (what == "R" and not smallest > 0):
+            raise ModelError(f"LQR: {what} must be {least} (a weight), its smallest eigenvalue is {smallest:.6g}")
     try:
         if dt is None:
             return np.linalg.solve(R, B.T @ solve_continuous_are(A, B, Q, R))

@@ -76,6 +76,8 @@ def per_sample(values, size: int, N: int, what: str) -> np.ndarray:
 def sample_inputs(n_w: int, N: int, dt: float, n_noise: int, seed: int) -> np.ndarray:
     """W (N + 1, n_w): column 0 the sample times k dt (s), columns 1..n_noise standard normal draws
     (seeded) behind sensor noise faults, the rest 0 for the caller to fill."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise SimulationError(f"seed must be an integer >= 0 (it seeds the noise draws), got {seed!r}")
     W = np.zeros((N + 1, n_w))
     W[:, 0] = dt * np.arange(N + 1)
     W[:, 1:1 + n_noise] = np.random.default_rng(seed).standard_normal((N + 1, n_noise))

@@ -82,6 +82,11 @@ class SimResult:
         t = np.asarray(self.t, dtype=float)
         if t.ndim != 1:
             raise SimulationError(f"t must be a 1-D array of times (s), got shape {t.shape}")
+        if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0):
+            bad = int(np.flatnonzero(~np.isfinite(t))[0]) if not np.all(np.isfinite(t)) else \
+                int(np.flatnonzero(np.diff(t) < 0)[0]) + 1
+            raise SimulationError(f"t must be finite and never decreasing (s); t[{bad}] = {float(t[bad])!r} after "
+                                  f"{float(t[bad - 1])!r}" if bad else f"t must be finite (s); t[0] = {float(t[0])!r}")
         for name, sig in self.signals.items():
             _text(name, "a signal name", allow_empty=False)
             if not isinstance(sig, Signal) or sig.values.shape[0] != t.size:

@@ -295,10 +295,8 @@ def fault_tables(items: list[_Fields], inputs: tuple[str, ...], outputs: tuple[s
                 label = fields.text("sensor", choices=outputs)
                 kind = fields.text("kind", choices=tuple(SENSOR_KINDS))
                 value = fields.number("value", 0.0 if kind == "stuck" else None)
-                fault = SensorFault(outputs.index(label), kind, value, _profile(fields))
-                if kind != "stuck" and fault.value == 0.0:
-                    raise ScenarioError(f"{fields.path}.value: a {kind} fault of 0 changes nothing")
-                sensor.append(fault)
+                sensor.append(SensorFault(outputs.index(label), kind, value, _profile(fields)))
+                fault = sensor[-1]
             else:
                 raise ScenarioError(f"{fields.path}: give either actuator = <input of {owner}> or sensor = "
                                     f"<measured signal of {owner}>")
@@ -324,9 +322,6 @@ def _check_actuator_value(fields: _Fields, fault: ActuatorFault) -> None:
     if kind.name == "proportional" and fault.value < 0.0:
         raise ScenarioError(f"{fields.path}.value: a proportional factor scales what the actuator delivers (1 "
                             f"healthy, 0 dead); {fault.value:g} would reverse it")
-    if kind.healthy is not None and fault.value == kind.healthy:
-        raise ScenarioError(f"{fields.path}.value: {fault.value:g} is the healthy value of a {kind.name} fault; "
-                            "this fault changes nothing")
 
 
 def _observers(items: list[_Fields], model: Model) -> tuple[ObserverSpec, ...]:

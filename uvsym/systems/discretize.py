@@ -17,6 +17,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from uvsym.errors import ModelError
+from uvsym.numbers import real
 from uvsym.symbolic import rk4
 from uvsym.systems.system import ARGUMENTS, System
 
@@ -26,7 +27,8 @@ METHODS = ("zoh", "rk4")
 
 
 def zoh_matrices(A, B, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """(Ad, Bd) of the exact zero-order hold of ``x' = A x + B u`` over ``dt`` s."""
+    """(Ad, Bd) of the exact zero-order hold of ``x' = A x + B u`` over ``dt`` s (ModelError for dt <= 0)."""
+    dt = real(dt, "zero-order hold: dt (s)", ModelError, positive=True)
     A, B = np.atleast_2d(np.asarray(A, dtype=float)), np.asarray(B, dtype=float).reshape(len(A), -1)
     n, m = A.shape[0], B.shape[1]
     augmented = np.zeros((n + m, n + m))
@@ -48,8 +50,7 @@ def discretize(system: System, dt: float, method: str = "zoh", steps: int = 1) -
         raise ModelError(f"unknown discretisation method {method!r}; known: {', '.join(METHODS)}")
     if system.discrete:
         raise ModelError(f"{system.name} is already discrete (dt = {system.dt} s)")
-    if not (np.isfinite(dt) and dt > 0):
-        raise ModelError(f"{system.name}: sample period dt must be positive and finite (s), got {dt}")
+    dt = real(dt, f"{system.name}: sample period dt (s)", ModelError, positive=True)
     if not (isinstance(steps, int) and steps >= 1):
         raise ModelError(f"{system.name}: steps must be a positive integer, got {steps!r}")
     x, u, d, p = (ca.SX.sym(a, s.size) for a, s in zip(ARGUMENTS, (system.x, system.u, system.d, system.p)))

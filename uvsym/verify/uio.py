@@ -106,10 +106,16 @@ def _inverse(A: Matrix) -> Matrix:
 def exact_zoh(A, B, dt) -> tuple[Matrix, Matrix]:
     """(Ad, Bd) of ``x' = A x + B u`` held over dt, exactly: ``expm(dt [[A, B], [0, 0]])`` as its
     finite series when that matrix is nilpotent. dt may be a Fraction (``Fraction(1, 100)``) or
-    a float (taken exactly). VerificationError when the augmented matrix is not nilpotent."""
+    a float (taken exactly), > 0. VerificationError for another dt or when the augmented matrix is not
+    nilpotent."""
     A, B = _rational(A), _rational(B)
     n, m = len(A), len(B[0])
-    step = Fraction(dt)
+    try:
+        step = Fraction(dt)
+    except (TypeError, ValueError, OverflowError):
+        raise VerificationError(f"exact_zoh: dt must be a finite number of seconds, got {dt!r}") from None
+    if not step > 0:
+        raise VerificationError(f"exact_zoh: dt must be positive (s), got {dt!r}")
     Maug = [[step * v for v in ra + rb] for ra, rb in zip(A, B)] + [[Fraction(0)] * (n + m) for _ in range(m)]
     total, term = _eye(n + m), _eye(n + m)
     for k in range(1, n + m + 1):

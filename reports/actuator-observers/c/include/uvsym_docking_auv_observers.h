@@ -11,6 +11,7 @@ typedef double uvsym_docking_auv_observers_real;
 #define UVSYM_DOCKING_AUV_OBSERVERS_EVAL_FAILED 1 /* CasADi's evaluation reported a failure */
 #define UVSYM_DOCKING_AUV_OBSERVERS_NONFINITE_INPUT 2 /* an input entry is NaN or infinite (finite check on): nothing computed, outputs untouched */
 #define UVSYM_DOCKING_AUV_OBSERVERS_NONFINITE_OUTPUT 3 /* an output entry is NaN or infinite (finite check on): outputs written */
+#define UVSYM_DOCKING_AUV_OBSERVERS_UNHEALTHY 4 /* an estimator's pd_margin output is not positive: a covariance it factorised is no longer positive definite (the Python run raises CovarianceError there); outputs written, not to be trusted */
 
 /* proportional observer of docking_auv (momentum form): continuous right-hand side
  *

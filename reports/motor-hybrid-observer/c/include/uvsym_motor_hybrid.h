@@ -11,6 +11,7 @@ typedef double uvsym_motor_hybrid_real;
 #define UVSYM_MOTOR_HYBRID_EVAL_FAILED 1 /* CasADi's evaluation reported a failure */
 #define UVSYM_MOTOR_HYBRID_NONFINITE_INPUT 2 /* an input entry is NaN or infinite (finite check on): nothing computed, outputs untouched */
 #define UVSYM_MOTOR_HYBRID_NONFINITE_OUTPUT 3 /* an output entry is NaN or infinite (finite check on): outputs written */
+#define UVSYM_MOTOR_HYBRID_UNHEALTHY 4 /* an estimator's pd_margin output is not positive: a covariance it factorised is no longer positive definite (the Python run raises CovarianceError there); outputs written, not to be trusted */
 
 /* hybrid unknown-input observer of induction_motor, detection observer (eq. 6), sampled every 0.0001 s (1 RK4 step(s))
  *

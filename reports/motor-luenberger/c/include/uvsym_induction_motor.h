@@ -10,6 +10,7 @@ typedef double uvsym_induction_motor_real;
 #define UVSYM_INDUCTION_MOTOR_EVAL_FAILED 1 /* CasADi's evaluation reported a failure */
 #define UVSYM_INDUCTION_MOTOR_NONFINITE_INPUT 2 /* an input entry is NaN or infinite (finite check on): nothing computed, outputs untouched */
 #define UVSYM_INDUCTION_MOTOR_NONFINITE_OUTPUT 3 /* an output entry is NaN or infinite (finite check on): outputs written */
+#define UVSYM_INDUCTION_MOTOR_UNHEALTHY 4 /* an estimator's pd_margin output is not positive: a covariance it factorised is no longer positive definite (the Python run raises CovarianceError there); outputs written, not to be trusted */
 
 /* Luenberger observer of induction_motor: xhat' = f(xhat, u) + L (y - h(xhat, u)), sampled every 0.0001 s (1 RK4 step(s) of the model)
  *

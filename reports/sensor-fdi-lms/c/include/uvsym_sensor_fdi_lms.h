@@ -11,6 +11,7 @@ typedef double uvsym_sensor_fdi_lms_real;
 #define UVSYM_SENSOR_FDI_LMS_EVAL_FAILED 1 /* CasADi's evaluation reported a failure */
 #define UVSYM_SENSOR_FDI_LMS_NONFINITE_INPUT 2 /* an input entry is NaN or infinite (finite check on): nothing computed, outputs untouched */
 #define UVSYM_SENSOR_FDI_LMS_NONFINITE_OUTPUT 3 /* an output entry is NaN or infinite (finite check on): outputs written */
+#define UVSYM_SENSOR_FDI_LMS_UNHEALTHY 4 /* an estimator's pd_margin output is not positive: a covariance it factorised is no longer positive definite (the Python run raises CovarianceError there); outputs written, not to be trusted */
 
 /* LMS-FIR monitor of psi: order 70, R window 20, hold 3, confirm 10 samples; p = (mu, eps0, r0); sampled every 0.2 s
  *

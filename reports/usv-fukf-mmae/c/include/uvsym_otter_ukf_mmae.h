@@ -11,6 +11,7 @@ typedef double uvsym_otter_ukf_mmae_real;
 #define UVSYM_OTTER_UKF_MMAE_EVAL_FAILED 1 /* CasADi's evaluation reported a failure */
 #define UVSYM_OTTER_UKF_MMAE_NONFINITE_INPUT 2 /* an input entry is NaN or infinite (finite check on): nothing computed, outputs untouched */
 #define UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT 3 /* an output entry is NaN or infinite (finite check on): outputs written */
+#define UVSYM_OTTER_UKF_MMAE_UNHEALTHY 4 /* an estimator's pd_margin output is not positive: a covariance it factorised is no longer positive definite (the Python run raises CovarianceError there); outputs written, not to be trusted */
 
 /* MMAE bank of UKF models nofault, left, right (floor 0.0001, federated reset), sampled every 0.05 s
  *
@@ -246,7 +247,7 @@ typedef double uvsym_otter_ukf_mmae_real;
  *       [13] loglik_right [-]
  *       [14] pd_margin [-]
  *       [15] skipped [-]
- * Returns UVSYM_OTTER_UKF_MMAE_OK, UVSYM_OTTER_UKF_MMAE_EVAL_FAILED, UVSYM_OTTER_UKF_MMAE_NONFINITE_INPUT or UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT.
+ * Returns UVSYM_OTTER_UKF_MMAE_OK, UVSYM_OTTER_UKF_MMAE_EVAL_FAILED, UVSYM_OTTER_UKF_MMAE_NONFINITE_INPUT, UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT or UVSYM_OTTER_UKF_MMAE_UNHEALTHY.
  * Uses static work buffers: not reentrant. */
 int uvsym_otter_ukf_mmae_ukf_step(const uvsym_otter_ukf_mmae_real s[100], const uvsym_otter_ukf_mmae_real y[6], const uvsym_otter_ukf_mmae_real u[2], const uvsym_otter_ukf_mmae_real p[2], uvsym_otter_ukf_mmae_real s_next[100], uvsym_otter_ukf_mmae_real out[16]);
 

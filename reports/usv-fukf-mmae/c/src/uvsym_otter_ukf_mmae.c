@@ -21,5 +21,6 @@ int uvsym_otter_ukf_mmae_ukf_step(const uvsym_otter_ukf_mmae_real s[100], const 
   if (uvsym_otter_ukf_mmae_casadi_ukf_step(arg, res, iw, w, 0)) return UVSYM_OTTER_UKF_MMAE_EVAL_FAILED;
   if (!uvsym_otter_ukf_mmae_all_finite(s_next, 100)) return UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT;
   if (!uvsym_otter_ukf_mmae_all_finite(out, 16)) return UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT;
+  if (!(out[14] > 0)) return UVSYM_OTTER_UKF_MMAE_UNHEALTHY;  /* pd_margin */
   return UVSYM_OTTER_UKF_MMAE_OK;
 }
