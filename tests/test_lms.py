@@ -263,7 +263,7 @@ def test_generated_c_of_the_monitor_matches_python(tmp_path):
 
 
 def test_mu_bound_names_itself_in_its_error():
-    with pytest.raises(ObserverError, match=r"^mu_bound: order M must be a positive integer, got 0$"):
+    with pytest.raises(ObserverError, match=r"^mu_bound: order M must be an integer in \[1, 4096\], got 0$"):
         mu_bound(0, 1.0)
 
 
@@ -362,11 +362,11 @@ def test_step_claim_of_a_silent_input_has_no_bound_and_states_its_claim():
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"order": 0}, "sensor_mon: order M must be a positive integer, got 0"),
-    ({"window": 0}, "sensor_mon: window n must be a positive integer, got 0"),
+    ({"order": 0}, "sensor_mon: order M must be an integer in [1, 4096], got 0"),
+    ({"window": 0}, "sensor_mon: window n must be an integer in [1, 4096], got 0"),
     ({"window": 1}, "sensor_mon: window n must be at least 2 samples (R needs a spread), got 1"),
-    ({"confirm": 0}, "sensor_mon: confirm must be a positive integer, got 0"),
-    ({"hold": 0}, "sensor_mon: hold must be a positive integer, got 0"),
+    ({"confirm": 0}, "sensor_mon: confirm must be an integer in [1, 4096], got 0"),
+    ({"hold": 0}, "sensor_mon: hold must be an integer in [1, 4096], got 0"),
     ({"mu": 0.0}, "sensor_mon: mu must be a positive, finite number, got 0.0"),
     ({"mu": True}, "sensor_mon: mu must be a positive, finite number, got True"),  # a flag is not a step
     ({"mu": "0.1"}, "sensor_mon: mu must be a positive, finite number, got '0.1'"),
@@ -388,7 +388,7 @@ def test_bad_names_and_signals_of_the_monitor_are_refused_naming_them():
 
 
 def test_bare_step_and_bound_refuse_bad_arguments_naming_themselves():
-    with pytest.raises(ObserverError, match=r"^lms_step: order M must be a positive integer, got 0$"):
+    with pytest.raises(ObserverError, match=r"^lms_step: order M must be an integer in \[1, 4096\], got 0$"):
         lms_step(0)
     with pytest.raises(ObserverError, match=r"^mu_bound: input power P_u must be a positive, finite number, got 0\.0$"):
         mu_bound(4, 0.0)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from derivations.papers import paper
-from derivations.sensor_fdi_lms.design import MU, ORDER, design
+from derivations.sensor_fdi_lms.design import ORDER, design
 from uvsym.codegen.estimators import exported_observer
 from uvsym.codegen.observer_sets import ObserverSet
 from uvsym.codegen.package import Exported
@@ -12,10 +12,10 @@ from uvsym.observers.lms import lms_step
 __all__ = ["lms_set"]
 
 
-def lms_set(order: int = ORDER, mu: float = MU) -> ObserverSet:
-    """The compass monitor (LMS-FIR of ``order`` taps, default step ``mu``; mu, eps0, r0 are run-time
-    parameters) and the bare LMS step it is built on."""
-    monitor = design(order=int(order), mu=float(mu)).monitor
+def lms_set(order: int = ORDER) -> ObserverSet:
+    """The compass monitor (LMS-FIR of ``order`` taps; its step mu, eps0 and r0 are run-time parameters
+    of every call, the paper's in the example) and the bare LMS step it is built on."""
+    monitor = design(order=order).monitor
     bare = Exported(lms_step(int(order)),
                     (f"C: weights ({order}, rad per unit u)", f"U: [u_(k-1) ... u_(k-{order})] (-)",
                      "target: y - r (rad)", "u: the new input u_k (-)", "mu: LMS step (-)"),

@@ -56,9 +56,12 @@ from uvsym.systems.signals import Signals, signals
 __all__ = ["lms_step", "lms_monitor", "mu_bound", "check_mu"]
 
 
-def _positive_int(value, what: str, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-        raise ObserverError(f"{name}: {what} must be a positive integer, got {value!r}")
+MAX_ORDER = 4096  # taps (and window samples): a step of this size is already thousands of operations
+
+
+def _positive_int(value, what: str, name: str, largest: int = MAX_ORDER) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 1 <= value <= largest:
+        raise ObserverError(f"{name}: {what} must be an integer in [1, {largest}], got {value!r:.40}")
     return int(value)
 
 

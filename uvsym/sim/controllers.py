@@ -62,6 +62,10 @@ class LineOfSight:
         points = np.asarray(self.waypoints, dtype=float)
         if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 2:
             raise ScenarioError("path.waypoints: expected a list of at least two [north, east] pairs (m)")
+        if not np.all(np.isfinite(points)):
+            row = int(np.flatnonzero(~np.all(np.isfinite(points), axis=1))[0])
+            raise ScenarioError(f"path.waypoints: waypoint {row} is {points[row].tolist()}; every waypoint must be "
+                                "finite (m)")
         if np.any(np.linalg.norm(np.diff(points, axis=0), axis=1) <= self.acceptance):
             raise ScenarioError("path.waypoints: every segment must be longer than path.acceptance")
         if not self.lookahead > 0.0:

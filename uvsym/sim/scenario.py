@@ -158,7 +158,7 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
         near = difflib.get_close_matches("plant", [str(k) for k in data], n=1, cutoff=0.7)
         raise ScenarioError("vehicle: missing; a vehicle scenario names its vehicle (vehicle = NAME), a scenario "
                             "over any other System its plant (plant = NAME or module:function; see uvsym models)"
-                            + (f"; is {near[0]!r} a misspelt 'plant'?" if near else ""))
+                            + (f"; is {near[0]!r} a misspelt 'plant'?" if near else top._misspelt("vehicle")))
     vehicle_name = top.text("vehicle")
     overrides = top.raw("vehicle_parameters", {}, "table", "parameter = value overrides (uvsym models show VEHICLE)")
     if not isinstance(overrides, dict):
@@ -229,7 +229,8 @@ def _controller(fields: _Fields | None, model: Model) -> Autopilot:
     if path_fields is not None:
         points = path_fields.raw("waypoints", None, "list of [north, east] pairs", "finite, m")
         if not isinstance(points, list) or not all(isinstance(p, list) and len(p) == 2 for p in points):
-            raise ScenarioError("controller.path.waypoints: expected a list of [north, east] pairs (m)")
+            raise ScenarioError("controller.path.waypoints: expected a list of [north, east] pairs (m)"
+                                + ("" if points is not None else path_fields._misspelt("waypoints")))
         for i, point in enumerate(points):
             for j, v in enumerate(point):
                 if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
@@ -336,13 +337,13 @@ def _observers(items: list[_Fields], model: Model) -> tuple[ObserverSpec, ...]:
         spec = ObserverSpec(kind=kind, form=fields.text("form", "paper", choices=FORMS),
                             time_constant=fields.number("time_constant", positive=True),
                             tau_d=None if not fields.has("tau_d") else tuple(fields.vector("tau_d", model.dof)))
+        fields.done()  # a misspelt key is named before the design reads a default in its place
         if actuator_kind(kind).scales and spec.tau_d is None:
             raise ScenarioError(f"{fields.path}.tau_d: the {kind} observer's gain design needs a nominal tau_d")
         try:
             design_gains(actuator_observer(model, kind, spec.form), spec.time_constant, spec.tau_d)
         except ObserverError as exc:
             raise ScenarioError(f"{fields.path}.tau_d: {exc}") from None
-        fields.done()
         specs[kind] = (fields.path, spec)
     return tuple(spec for _, spec in specs.values())
 
