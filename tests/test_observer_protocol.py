@@ -367,3 +367,30 @@ def test_an_input_count_mismatch_lists_the_named_signals():
     with pytest.raises(ObserverError) as caught:
         _direct(state=("a", "z"))
     assert str(caught.value) == "luen: step input s has 1 entries but 2 signal signals are named (a, z)"
+
+
+def test_run_goes_in_fixed_chunks_with_the_numbers_of_one_step_after_another(monkeypatch):
+    """Linear in N: the steps are rolled in chunks of RUN_CHUNK (one mapaccum per chunk size, built once),
+    never one mapaccum(N); the result is that of calling the step sample after sample."""
+    import numpy as np
+
+    from problems import double_integrator
+
+    from uvsym.observers import base
+    from uvsym.observers.ukf import ukf
+
+    obs = ukf(double_integrator(outputs=("pos",)), dt=0.1, Q=np.diag([1e-6, 1e-4]), R=1e-4, P0=np.eye(2))
+    monkeypatch.setattr(base, "RUN_CHUNK", 64)
+    sizes = []
+    rolled = base._rolled
+    monkeypatch.setattr(base, "_rolled", lambda step, k: sizes.append(k) or rolled(step, k))
+    N = 64 * 3 + 7
+    Y, U = np.random.default_rng(1).normal(scale=0.01, size=(N, 1)), np.zeros((N, 1))
+    S, OUT = obs.run(Y, U)
+    assert sizes == [64, 64, 64, 7]
+    s, p = S[0], obs.parameters(None)
+    for k in range(N):  # one step after another, from the same initial state
+        s_next, out = (np.asarray(v).ravel() for v in obs.step(s, Y[k], U[k], p))
+        np.testing.assert_array_equal(S[k + 1], s_next)
+        np.testing.assert_array_equal(OUT[k], out)
+        s = s_next

@@ -34,6 +34,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.checked import checked
+from uvsym.codegen.cache import memoized
 from uvsym.errors import ObserverError
 from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
@@ -148,8 +149,22 @@ class Observer:
             np.asarray(s0, dtype=float).reshape(-1)
         if s.size != self.state.size or not np.all(np.isfinite(s)):
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
-        S, OUT = self.step.mapaccum("run", len(Y), [0], [0])(s, Y.T, U.T, p)
-        return np.vstack([s, np.asarray(S).T]), np.asarray(OUT).T
+        states, outputs = [s[None, :]], []
+        for start in range(0, len(Y), RUN_CHUNK):  # fixed chunks: the cost is linear in N (one mapaccum(N) is not)
+            k = min(RUN_CHUNK, len(Y) - start)
+            S, OUT = _rolled(self.step, k)(states[-1][-1], Y[start:start + k].T, U[start:start + k].T, p)
+            states.append(np.asarray(S).T.reshape(k, -1))
+            outputs.append(np.asarray(OUT).T.reshape(k, -1))
+        return np.vstack(states), np.vstack(outputs)
+
+
+RUN_CHUNK = 2048  # samples per mapaccum call of Observer.run
+
+
+@memoized(32)
+def _rolled(step: ca.Function, k: int) -> ca.Function:
+    """``k`` steps of ``step`` accumulated on the state (its first input and output), built once per size."""
+    return step.mapaccum("run", k, [0], [0])
 
 
 def check_name(name: str, what: str, error=ObserverError) -> None:
