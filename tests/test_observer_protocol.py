@@ -373,7 +373,6 @@ def test_run_goes_in_fixed_chunks_with_the_numbers_of_one_step_after_another(mon
     """Linear in N: the steps are rolled in chunks of RUN_CHUNK (one mapaccum per chunk size, built once),
     never one mapaccum(N); the result is that of calling the step sample after sample."""
     import numpy as np
-
     from problems import double_integrator
 
     from uvsym.observers import base

@@ -22,6 +22,7 @@ from uvsym.diagnosis.events import Event
 from uvsym.diagnosis.monitor import ActuatorDiagnosis, residual_noise
 from uvsym.diagnosis.settings import DiagnosisSettings
 from uvsym.errors import ScenarioError
+from uvsym.faults import SensorFault
 from uvsym.sim.actuator_block import ActuatorObserverBlock
 from uvsym.sim.fields import Fields
 
@@ -63,7 +64,7 @@ class WiredDiagnosis:
 
 def fault_diagnosis_detector(fields: Fields, name: str, scenario_loop, z0, w0, step: float) -> WiredDiagnosis:
     """The detector of a ``[[detectors]]`` table of type fault_diagnosis (module docstring)."""
-    from uvsym.sim.scenario import diagnosis_settings
+    from uvsym.sim.scenario import diagnosis_settings, whole_run_noise
     from uvsym.sim.system_scenario import logged_input
 
     blocks = {b.name: b for b in scenario_loop.blocks}
@@ -76,9 +77,7 @@ def fault_diagnosis_detector(fields: Fields, name: str, scenario_loop, z0, w0, s
                             f"such blocks: {', '.join(candidates) or 'none (add one)'}")
     block = blocks[observer]
     plant = scenario_loop.plant
-    noise = {plant.y.names[f.channel]: f.value for f in scenario_loop.faults
-             if getattr(f, "kind", None) == "noise" and hasattr(f, "channel") and f.profile.onset == 0.0
-             and math.isinf(f.profile.end)}
+    noise = whole_run_noise([f for f in scenario_loop.faults if isinstance(f, SensorFault)], plant.y.names)
     settings = diagnosis_settings(fields, block.model, observer, noise, math.inf, step)
     if settings.correct:
         raise ScenarioError(f"{fields.path}.correct: a command correction changes the loop while it runs: it needs "

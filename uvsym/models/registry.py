@@ -42,14 +42,20 @@ def vehicle(name: str, **overrides) -> Model:
     """
     if name not in VEHICLES:
         raise UnknownNameError(f"unknown vehicle {name!r}; known vehicles: {', '.join(VEHICLES)}")
+    return built_with(_build_cached, name, "model", overrides)
+
+
+def built_with(build: Callable, name: str, what: str, overrides: dict):
+    """``build(name, frozen overrides)`` (each override hashable by :func:`frozen_override`); ModelError
+    naming the overrides when the equations cannot take them (a square root of a negative, ...)."""
     frozen = tuple(sorted((key, frozen_override(name, key, value)) for key, value in overrides.items()))
     try:
-        return _build_cached(name, frozen)
+        return build(name, frozen)
     except UvsymError:
         raise
-    except (ArithmeticError, ValueError, TypeError, np.linalg.LinAlgError) as exc:  # an override the equations
-        shown = ", ".join(f"{key}={value!r}" for key, value in overrides.items())  # cannot take (sqrt of < 0, ...)
-        raise ModelError(f"{name}: the model cannot be built with {shown}: {type(exc).__name__}: {exc}") from None
+    except (ArithmeticError, ValueError, TypeError, np.linalg.LinAlgError) as exc:
+        shown = ", ".join(f"{key}={value!r}" for key, value in overrides.items())
+        raise ModelError(f"{name}: the {what} cannot be built with {shown}: {type(exc).__name__}: {exc}") from None
 
 
 def frozen_override(owner: str, key: str, value):

@@ -181,8 +181,10 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool
             signals = {name: Signal(by_lane[lane, :, sl], labels, units)
                        for name, (sl, labels, units) in loop.signals.items()}
             meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}
-            if run.rk4_tolerance is not None and loop.plant_ode is not None:  # as the scalar path checks it
-                meta["rk4_error"] = checked_steps(loop, by_lane[lane], run.W, run.rk4_tolerance)
+            checked = None if run.rk4_tolerance is None else checked_steps(loop, by_lane[lane], run.W,
+                                                                             run.rk4_tolerance)
+            if checked is not None:  # as the scalar path checks it
+                meta["rk4_error"] = checked
             results.append(SimResult(run.W[:, 0].copy(), signals, meta))
     return results
 

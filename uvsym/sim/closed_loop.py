@@ -59,8 +59,8 @@ class ClosedLoop(SampledLoop):
 
     def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """s = [x; a] (a: the actuators' own state, u_actual less its fault) and u_command, per logged row."""
-        a = self._logged(out, "u_actual") - self._logged(out, "fault_actuator")
-        return np.hstack([self._logged(out, "x"), a]), self._logged(out, "u_command")
+        a = self.logged(out, "u_actual") - self.logged(out, "fault_actuator")
+        return np.hstack([self.logged(out, "x"), a]), self.logged(out, "u_command")
 
 
 def _by_name(names: tuple[str, ...], available: dict, observer: str):

@@ -51,7 +51,8 @@ class SampledLoop:
         for a loop that does not say (its fast path's step error is then not checked)."""
         return None
 
-    def _logged(self, out: np.ndarray, name: str) -> np.ndarray:
+    def logged(self, out: np.ndarray, name: str) -> np.ndarray:
+        """The columns of the logged signal ``name`` in logged rows ``out`` (k, n_out)."""
         return out[:, self.signals[name][0]]
 
 

@@ -359,9 +359,14 @@ def _diagnosis(fields: _Fields | None, model: Model, observers: tuple[ObserverSp
     if name not in [observer.kind for observer in observers]:
         raise ScenarioError("diagnosis.observer: the diagnosis reads the bias observer's estimate, and the scenario "
                             "runs none; add [[observers]] with kind = \"bias\"")
-    noise = {model.state_labels[f.channel]: f.value for f in sensor_faults
-             if f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end)}
-    return diagnosis_settings(fields, model, name, noise, duration, step)
+    return diagnosis_settings(fields, model, name, whole_run_noise(sensor_faults, model.state_labels), duration, step)
+
+
+def whole_run_noise(sensor_faults, labels: tuple[str, ...]) -> dict[str, float]:
+    """Measured channel -> standard deviation of the Gaussian noise faults acting for the whole run (the
+    sensors' specification), from sensor faults indexing ``labels``."""
+    return {labels[f.channel]: f.value for f in sensor_faults
+            if f.kind == "noise" and f.profile.onset == 0.0 and math.isinf(f.profile.end)}
 
 
 def diagnosis_settings(fields: _Fields, model: Model, observer: str, noise: dict[str, float], duration: float,

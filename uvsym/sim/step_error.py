@@ -98,7 +98,7 @@ def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> St
     S, U = read
     scale = tolerance * np.max(np.abs(S), axis=0) + ATOL
     doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
-    faulty = loop._logged(outputs, "fault_actuator") != 0
+    faulty = loop.logged(outputs, "fault_actuator") != 0
     ks = check_indices(U, np.any(faulty[1:] != faulty[:-1], axis=1) if faulty.shape[1] else None)
     worst = (0.0, 0.0, 0)
     for k in ks:

@@ -88,7 +88,7 @@ class WiredLoop(SampledLoop):
 
     def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """s = x and the plant inputs as commanded (u less its actuator fault), per logged row."""
-        return self._logged(out, "x"), self._logged(out, "u") - self._logged(out, "fault_actuator")
+        return self.logged(out, "x"), self.logged(out, "u") - self.logged(out, "fault_actuator")
 
 
 def _column(items) -> ca.SX:

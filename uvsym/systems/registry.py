@@ -10,9 +10,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 
-import numpy as np
-
-from uvsym.errors import ModelError, UnknownNameError, UvsymError
+from uvsym.errors import UnknownNameError
 from uvsym.systems.plants import induction_motor, quadrotor, rov_yaw
 from uvsym.systems.system import System
 
@@ -57,13 +55,6 @@ def plant(name: str, **overrides) -> System:
     """
     if name not in PLANTS and name not in _vehicle_names():
         raise UnknownNameError(f"unknown plant {name!r}; known plants: {', '.join(plant_names())}")
-    from uvsym.models.registry import frozen_override
+    from uvsym.models.registry import built_with
 
-    frozen = tuple(sorted((key, frozen_override(name, key, value)) for key, value in overrides.items()))
-    try:
-        return _build_cached(name, frozen)
-    except UvsymError:
-        raise
-    except (ArithmeticError, ValueError, TypeError, np.linalg.LinAlgError) as exc:
-        shown = ", ".join(f"{key}={value!r}" for key, value in overrides.items())
-        raise ModelError(f"{name}: the plant cannot be built with {shown}: {type(exc).__name__}: {exc}") from None
+    return built_with(_build_cached, name, "plant", overrides)
