@@ -140,12 +140,16 @@ def _cmd_report(args) -> int:
 
 
 def _scenario_path(source: str) -> Path:
-    """A scenario file, or the file of a shipped scenario (uvsym's or a derivation's) named ``source``."""
-    from uvsym.sim.scenario import every_shipped_scenario
+    """A scenario file, or the file of a shipped scenario (uvsym's, found without importing the
+    derivations, else a derivation's) named ``source``."""
+    from uvsym.sim.scenario import every_shipped_scenario, shipped_scenarios
 
     path = Path(source)
     if path.exists():
         return path
+    own = {**shipped_scenarios(), **shipped_scenarios("plant")}
+    if source in own:
+        return own[source]
     shipped = every_shipped_scenario()
     if source not in shipped:
         raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
