@@ -113,3 +113,30 @@ def test_without_noise_the_step_estimate_settles_at_its_closed_form_bias():
     final = float(np.mean(r["estimator_f_s_hat"][r["t"] >= r["t"][-1] - 1.0]))
     assert abs(final - (1.0 - L2 / (L2 + 2.0 * float(ESTIMATOR.Gamma[0, 0] * ESTIMATOR.M1[0, 0])))) < 1e-3
     assert final >= 0.996
+
+
+def test_a_load_torque_moves_the_operating_point_to_slip_and_keeps_it_an_equilibrium():
+    idle, loaded = uvsym.plant("induction_motor"), uvsym.plant("induction_motor", T_L=20.0)
+    assert idle.x_op[0] == 0.0 and idle.x_op[4] == 250.0  # the shipped zero-slip point, exactly
+    c = loaded.constants
+    i_sq = 20.0 * c.v("Lr") / (c.v("n_p") * c.v("Lm") ** 2 * c.v("I0"))  # torque n_p Lm/Lr lambda_rd i_sq = T_L
+    slip = c.v("Rr") / c.v("Lr") * i_sq / c.v("I0")
+    np.testing.assert_allclose(loaded.x_op[[0, 4]], [i_sq, (c.v("omega_s") - slip) / c.v("n_p")], rtol=1e-12)
+    f = np.array(loaded.f(loaded.x_op, loaded.u_op, np.zeros(5), loaded.p0)).ravel()
+    assert np.max(np.abs(f / np.array([1e3, 1e3, 1.0, 1.0, 1e2]))) < 1e-12
+    with pytest.raises(ModelError, match="I0"):
+        uvsym.plant("induction_motor", T_L=5.0, I0=0.0)
+
+
+def test_under_load_the_rotor_resistance_rise_moves_only_the_speed():
+    from derivations.motor_hybrid_observer.identifiability import indistinguishable_offsets
+
+    out = indistinguishable_offsets(load=20.0, rises=(1.0, 0.5))
+    i_sq, slip = out["operating_point"][0], out["slip_rad_per_s"]
+    for rise in ("1", "0.5"):
+        row = out[rise]
+        assert row["currents_change_A"] < 1e-9 and row["fluxes_change_Wb"] < 1e-12
+        # the slip scales with Rr: d omega_m = -rise slip / n_p, mimicked by f_s = -d omega_m / F2 (F2 = 2)
+        assert row["speed_change_rad_per_s"] == pytest.approx(-float(rise) * slip / 2.0, rel=1e-9)
+        assert row["mimicking_offset_rad_per_s"] == pytest.approx(float(rise) * slip / 4.0, rel=1e-9)
+    assert i_sq > 30.0  # a loaded point: rotor current flows

@@ -12,6 +12,7 @@ from derivations.motor_hybrid_observer.campaign import campaign_results
 from derivations.motor_hybrid_observer.claims import hybrid_claims
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_hybrid_observer.experiment import CASES, DURATION, run_cases
+from derivations.motor_hybrid_observer.identifiability import indistinguishable_offsets
 from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from derivations.motor_hybrid_observer.text import report_text
 from uvsym.report import save_svg, write_json
@@ -192,7 +193,9 @@ def build(out_dir: Path, progress) -> None:
     progress("C package of the four observers: write, compile, compare")
     c = c_package(motor_hybrid(), out_dir / "c")
     campaign = campaign_results(progress)
-    results = _results(cases) | {"c": c, "claims": claim_rows(claims),
+    progress("loaded operating point: equilibria with the rotor resistance raised")
+    results = _results(cases) | {"loaded_identifiability": indistinguishable_offsets(), "c": c,
+                                 "claims": claim_rows(claims),
                                  "claim_evidence": [c.counterexample for c in claims], "campaign": campaign}
     write_json(out_dir / "results.json", results)
     (out_dir / "report.md").write_text(report_text(results, figures))

@@ -65,6 +65,32 @@ def _verdict(r: dict, runs: str = "") -> str:
     return " (target missed: " + ", ".join(f"case {c} by {gap:.1e}" for c, gap in short) + ")"
 
 
+def _loaded(li: dict) -> str:
+    """The section on the loaded operating point (:mod:`derivations.motor_hybrid_observer.identifiability`)."""
+    rows = [[f"+{100 * float(k):g} %", f"{v['currents_change_A']:.1e}", f"{v['fluxes_change_Wb']:.1e}",
+             f"{v['speed_change_rad_per_s']:.4f}", f"{v['mimicking_offset_rad_per_s']:.4f}"]
+            for k, v in li.items() if isinstance(v, dict)]
+    return f"""## Under load: what the rotor-resistance change does (not in the paper)
+
+At the shipped zero-slip point no rotor current flows and the rotor-resistance change acts on
+nothing. Under a load of {li["load_N_m"]:g} N m (operating point omega_m = {li["operating_point"][4]:.4f} rad/s,
+i_sq = {li["operating_point"][0]:.3f} A, slip {li["slip_rad_per_s"]:.3f} rad/s electrical) the motor is solved for its
+equilibrium on the same voltages with the rotor resistance raised:
+
+{markdown_table(["rotor resistance", "currents change (A)", "fluxes change (Wb)", "speed change (rad/s)",
+                 "sensor offset f_s that mimics it (rad/s)"], rows)}
+
+The electrical state does not move (the rotor branch sees Rr / slip, so the slip scales with Rr
+and the torque stays at the load); only the speed drops. A speed reading omega_m + 2 f_s is then
+the same as a healthy motor's with the offset in the last column: from steady-state currents,
+voltages and the speed reading no estimator separates the two, so a fault estimate at
++100 % rotor resistance and this load is off by that offset unless the design has information from
+outside the steady state (the rotor resistance learnt while the sensor is healthy, or the speed
+integrated through the torque balance after the onset). The corrected design above is built at
+the zero-slip point and does not have it.
+"""
+
+
 def report_text(r: dict, figures: list[tuple[str, str]]) -> str:
     """The report (the paper's claims, their machine checks, the corrected design, the runs)."""
     base = r["baseline_detection_time_s"]
@@ -209,6 +235,8 @@ after {DURATION:g} s ({wander} rad/s with the calibration runs' noise draws); th
 the noise level.
 
 {figs}
+
+{_loaded(r["loaded_identifiability"])}
 
 {campaign_section(r["campaign"])}
 ## Generated C

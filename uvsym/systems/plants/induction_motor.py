@@ -7,7 +7,7 @@ i_sd, omega_m)::
     A = [[-gamma, -omega_s, alpha beta, 0, 0], [omega_s, -gamma, 0, alpha beta, 0],
          [alpha Lm, 0, -alpha, -omega_s, 0], [0, alpha Lm, omega_s, -alpha, 0], [0, 0, 0, 0, 0]]
     F_a(x) = (-n_p beta omega_m lambda_rd, n_p beta omega_m lambda_rq, n_p omega_m lambda_rd,
-              -n_p omega_m lambda_rq, mu (lambda_rd i_sq - lambda_rq i_sd))
+              -n_p omega_m lambda_rq, mu (lambda_rd i_sq - lambda_rq i_sd) - T_L / J)
     B = [I_2; 0] / (delta Ls)
     E = [[-beta Lm/Lr, 0, beta/Lr, 0, 0], [0, -beta Lm/Lr, 0, beta/Lr, 0],
          [Lm/Lr, 0, -1/Lr, 0, 0], [0, Lm/Lr, 0, -1/Lr, 0], [0, 0, 0, 0, 0]]
@@ -21,11 +21,14 @@ the default here; ``build(printed_typo=True)`` gives the printed form.
 Disturbance: f is affine in Rr with ``df/dRr = E x``, so ``d = dRr * x`` (5 entries, dRr the
 rotor-resistance change in Ohm) makes ``E d`` the exact effect of ``Rr -> Rr + dRr``.
 
-Operating point (zero slip: the model has no load torque, so omega_m' = 0 needs zero torque):
-``omega_m = omega_s / n_p``, ``i_sq = lambda_rq = 0``, ``i_sd = I0``, ``lambda_rd = Lm I0``,
-``u_sq = delta Ls omega_s I0 (1 + beta Lm)`` (= ``omega_s Ls I0``), ``u_sd = Rs I0``: an
-equilibrium of the consistent form, not of the printed one (rows 3-4 then leave
-``+-n_p (beta - 1) omega_m lambda``).
+The load torque T_L (N m, a known parameter; the paper has none, default 0) brakes the speed.
+Operating point (rotor-flux oriented): ``lambda_rq = 0``, ``i_sd = I0``, ``lambda_rd = Lm I0``,
+``i_sq = T_L / (J mu Lm I0)`` (torque balance), slip ``omega_sl = alpha i_sq / I0`` (rotor q-flux
+balance), ``omega_m = (omega_s - omega_sl) / n_p``, ``u_sq = delta Ls (omega_s I0 (1 + beta Lm) +
+gamma i_sq - omega_sl beta Lm I0)``, ``u_sd = Rs I0 - delta Ls omega_s i_sq``. With T_L = 0 this is
+the zero-slip point ``omega_m = omega_s / n_p``, ``i_sq = 0``, ``u_sq = omega_s Ls I0``,
+``u_sd = Rs I0``. An equilibrium of the consistent form, not of the printed one (rows 3-4 then
+leave ``+-n_p (beta - 1) omega_m lambda``).
 
 Numbers: the paper's are in a reference it does not reproduce; these are the Modelica Standard
 Library IM_SquirrelCageData defaults at full precision (Lm = 3 sqrt(1 - 0.0667) / (2 pi 50 Hz),
@@ -103,19 +106,26 @@ def build(printed_typo: bool = False, **overrides) -> System:
     k, m = coefficients(p), matrices(p)
     n_p, beta, mu = p.v("n_p"), k["beta"], k["mu"]
     flux_gain = n_p * beta if printed_typo else n_p
+    load = p.v("T_L") / p.v("J")  # rad/s^2
 
     def rhs(x, u, d, _p):
         i_sq, i_sd, l_rq, l_rd, w_m = (x[i] for i in range(5))
         F_a = ca.vertcat(-n_p * beta * w_m * l_rd, n_p * beta * w_m * l_rq, flux_gain * w_m * l_rd,
-                         -flux_gain * w_m * l_rq, mu * (l_rd * i_sq - l_rq * i_sd))
+                         -flux_gain * w_m * l_rq, mu * (l_rd * i_sq - l_rq * i_sd) - load)
         return ca.mtimes(ca.DM(m["A"]), x) + F_a + ca.mtimes(ca.DM(m["B"]), u) + ca.mtimes(ca.DM(m["E"]), d)
 
     I0, w_s, Ls, Lm = p.v("I0"), p.v("omega_s"), p.v("Ls"), p.v("Lm")
+    if p.v("T_L") and not I0 > 0:
+        raise ModelError(f"{NAME}: a load torque T_L = {p.v('T_L'):g} N m needs a magnetising current I0 > 0")
+    i_sq = p.v("T_L") / (p.v("J") * mu * Lm * I0) if p.v("T_L") else 0.0  # A: torque balance (module docstring)
+    slip = k["alpha"] * i_sq / I0  # rad/s, electrical
     form = "printed F_a (n_p beta in rows 3-4)" if printed_typo else "F_a rows 3-4 with n_p"
     return system(NAME, f"{DESCRIPTION}; {form}", x=STATES, u=INPUTS, d=DISTURBANCES, y=OUTPUTS, rhs=rhs,
                   output=lambda x, u, _p: ca.mtimes(ca.DM(m["C"]), x),
-                  x_op=[0.0, I0, 0.0, Lm * I0, w_s / n_p],
-                  u_op=[k["delta"] * Ls * w_s * I0 * (1 + beta * Lm), p.v("Rs") * I0],
+                  x_op=[i_sq, I0, 0.0, Lm * I0, (w_s - slip) / n_p],
+                  u_op=[k["delta"] * Ls * w_s * I0 * (1 + beta * Lm) + k["delta"] * Ls * (k["gamma"] * i_sq
+                                                                                       - slip * beta * Lm * I0),
+                        p.v("Rs") * I0 - k["delta"] * Ls * w_s * i_sq],
                   constants=p, extras={"coefficients": k, "printed_typo": printed_typo},
                   source="Yu, Jiang & Zhang (2018) eq. 23 and its A, F_a, B, C, E; parameters: Modelica Standard "
                          "Library IM_SquirrelCageData defaults; omega_s = 500 rad/s and I0 are uvsym's choices")
