@@ -115,6 +115,7 @@ def _selected(names: list[str]) -> list[Derivation]:
 
 
 def _cmd_report(args) -> int:
+    from uvsym.report.figures import figure_style
     from uvsym.report.html import write_html
 
     selected = _selected(args.names)
@@ -129,7 +130,8 @@ def _cmd_report(args) -> int:
         def progress(message: str, _name=study.name, _index=index) -> None:
             print(f"[{_index}/{len(selected)}] {_name}: {message}", file=sys.stderr, flush=True)
 
-        study.build(out_dir, progress)
+        with figure_style():  # every figure of every report in uvsym's one style
+            study.build(out_dir, progress)
         progress("report.html")
         write_html(out_dir)
         stamp = {"derivation": study.name, "source_fingerprint": source_fingerprint(study),
@@ -307,7 +309,13 @@ def _cmd_codegen(args) -> int:
 
     make_folder(claim_folder(args.out, "the C package", "package", args.force,
                              built=make_products(observers.package_name)), "the C package")
-    manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check)
+    if args.budget and not args.target:
+        raise UvsymError(f"uvsym codegen {args.name}: --budget needs --target")
+    from uvsym.codegen.target_run import parse_budget
+
+    budget = parse_budget(args.budget or "")
+    manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check,
+                               target=args.target, budget=budget)
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "
           f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
@@ -316,6 +324,10 @@ def _cmd_codegen(args) -> int:
         check = manifest["float_check"]
         print(f"float against double on {check['source']}: largest relative difference "
               f"{check['max_relative_difference']:.2g} (limit {check['tolerance']:g})")
+    if "target" in manifest:
+        from uvsym.codegen.readme import target_lines
+
+        print("\n".join(target_lines(manifest["target"])))
     return 0
 
 
@@ -508,6 +520,11 @@ def _parser() -> argparse.ArgumentParser:
                                                               "refused when it strays from double on the set's example")
     codegen.add_argument("--no-finite-check", action="store_true",
                          help="wrappers without the NaN/infinity check of inputs and outputs (codes 2 and 3)")
+    codegen.add_argument("--target", choices=("cortex-m4f", "cortex-m7", "host"),
+                         help="also build for this target (target/: Makefile 'target', CMake toolchain, harness), "
+                              "run it (qemu for Cortex-M) and record flash, RAM, stack, instructions per call")
+    codegen.add_argument("--budget", help="with --target: refuse the package beyond these figures, e.g. "
+                                          "flash=65536,ram=16384,stack=5120,instructions=50000")
     codegen.set_defaults(run=_cmd_codegen)
     campaign = sub.add_parser("campaign", help="run a campaign file: scenarios over grids and Monte Carlo draws, "
                                                "on local processes or Dask; results, summary and report; resumable")

@@ -18,12 +18,16 @@ def make_products(name: str) -> tuple[str, ...]:
     """The files ``make`` writes in package ``name``'s folder (what ``make clean`` removes): uvsym's own
     output too, so that writing the package again over a built one is not refused."""
     return (f"src/{name}_casadi.o", f"src/{name}.o", "main.o", "harness.o", f"lib{name}.a", f"lib{name}.so",
-            "example", "harness")
+            "example", "harness", "target/harness.elf")
 
 
-def makefile(name: str) -> str:
-    """The package's Makefile (``make``; ``make CFLAGS=...`` to change flags)."""
+def makefile(name: str, target=None) -> str:
+    """The package's Makefile (``make``; ``make CFLAGS=...`` to change flags); with a
+    :class:`~uvsym.codegen.targets.Target`, its ``target`` and ``run-target`` rules too."""
+    from uvsym.codegen.targets import target_make_rules
+
     products = make_products(name)
+    rules = target_make_rules(name, target) if target is not None else ""
     return f"""# Builds lib{name}.a, lib{name}.so, the example and the harness.
 # CFLAGS may be overridden freely (e.g. make CFLAGS="-std=c99 -O2 {' '.join(WARNINGS)} -Werror -fPIC");
 # include paths live in CPPFLAGS.
@@ -54,7 +58,7 @@ clean:
 \trm -f $(OBJ) main.o harness.o lib{name}.a lib{name}.so example harness
 
 .PHONY: all clean
-"""
+{rules}"""
 
 
 def cmake_lists(name: str) -> str:

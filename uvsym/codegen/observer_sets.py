@@ -9,10 +9,12 @@ option the factory does not take.
 from __future__ import annotations
 
 import inspect
+import tempfile
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from uvsym.codegen import targets
 from uvsym.codegen.example import Example
 from uvsym.codegen.package import Exported, write_package
 from uvsym.codegen.precision import FLOAT_TOLERANCE, checked_float
@@ -45,13 +47,19 @@ class ObserverSet:
                                f"not {type(self.example).__name__}")
 
     def write(self, out_dir, precision: str = "double", finite_check: bool = True,
-              float_tolerance: float = FLOAT_TOLERANCE) -> dict:
+              float_tolerance: float = FLOAT_TOLERANCE, target: str | None = None,
+              budget: dict[str, int] | None = None) -> dict:
         """Write the C package into ``out_dir`` (:func:`uvsym.codegen.package.write_package`); the manifest.
 
         A float package is first run against double precision on the set's example
         (:func:`uvsym.codegen.precision.checked_float`) and refused with PrecisionError beyond
         ``float_tolerance``; its figure goes into the manifest (``float_check``). A set without an
         example is written in float with a warning that it was not measured.
+
+        target: a name of :data:`uvsym.codegen.targets.TARGETS`; the package is first built and run
+        for it in a scratch folder (:func:`uvsym.codegen.target_run.run_target`), its figures and
+        its distance from Python go into the manifest (``target``) and README, and a figure beyond
+        ``budget`` (flash, ram, stack, instructions) refuses the package with BudgetError.
         """
         extra = {}
         if precision == "float":
@@ -64,8 +72,31 @@ class ObserverSet:
                     raise CodegenError(f"observer set {self.package_name}: its example calls {self.example.function}, "
                                        f"which it does not export")
                 extra["float_check"] = checked_float(exported, self.example, float_tolerance).to_dict(float_tolerance)
+        chosen = None
+        if target is not None:
+            chosen = targets.target(target)
+            extra["target"] = self._measure_target(chosen, precision, finite_check, budget or {})
         return write_package(out_dir, list(self.exported), self.package_name, precision, self.description,
-                             citation=self.citation, example=self.example, finite_check=finite_check, extra=extra)
+                             citation=self.citation, example=self.example, finite_check=finite_check, extra=extra,
+                             target=chosen)
+
+    def _measure_target(self, chosen, precision: str, finite_check: bool, budget: dict[str, int]) -> dict:
+        """The target figures of this set's package (``write``), checked against ``budget``."""
+        from uvsym.codegen.target_run import check_budget, differences, run_target
+
+        with tempfile.TemporaryDirectory(prefix="uvsym-target-") as scratch:
+            functions = list(self.exported)
+            write_package(scratch, functions, self.package_name, precision, finite_check=finite_check,
+                          example=self.example, target=chosen)
+            run = run_target(scratch, functions, self.package_name, precision, chosen)
+        figures = run.figures
+        vectors = targets.target_vectors(functions, self.example)
+        for name, difference in differences(functions, vectors, run, precision).items():
+            figures["functions"][name]["difference"] = float(f"{difference:.3g}")
+        figures["difference_unit"] = ("ulp (2^-52) of each output's scale max(1, max|Python|)" if precision == "double"
+                                      else "relative to each output's scale max(1, max|Python|)")
+        check_budget(figures, budget)
+        return figures
 
 
 def options_of(factory: Callable[..., ObserverSet]) -> tuple[str, ...]:

@@ -217,12 +217,14 @@ def _argument_entry(name: str, size: int, doc) -> dict:
 
 def write_package(out_dir, functions: list[Exported], name: str, precision: str = "double",
                   description: str = "", *, citation: str = "", example: Example | None = None,
-                  finite_check: bool = True, extra: dict | None = None) -> dict:
+                  finite_check: bool = True, extra: dict | None = None, target=None) -> dict:
     """Write the package (module docstring) into ``out_dir``; returns the manifest.
 
     citation: the reference of the method implemented (header, README, manifest); example: data
     for ``main.c`` (:class:`~uvsym.codegen.example.Example`), else it calls on zeros;
-    finite_check: wrappers check inputs and outputs for NaN and infinity; extra: more manifest keys.
+    finite_check: wrappers check inputs and outputs for NaN and infinity; extra: more manifest keys;
+    target: a :class:`~uvsym.codegen.targets.Target` whose build files and harness go into ``target/``
+    (:func:`uvsym.codegen.targets.target_files`).
     """
     if precision not in PRECISIONS:
         raise CodegenError(f"unknown precision {precision!r}; known: {', '.join(PRECISIONS)}")
@@ -253,7 +255,11 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
              f"include/{name}.h": _header(name, description, citation, precision, wrappers),
              f"src/{name}.c": includes + all_finite + "\n".join(b for _, b in wrappers),
              "main.c": example_program(functions, name, example), "harness.c": harness_program(functions, name),
-             "Makefile": makefile(name), "CMakeLists.txt": cmake_lists(name)}
+             "Makefile": makefile(name, target), "CMakeLists.txt": cmake_lists(name)}
+    if target is not None:
+        from uvsym.codegen.targets import target_files, target_vectors
+
+        texts |= target_files(functions, name, precision, target, target_vectors(functions, example))
     manifest = {
         "package": name, "description": description, "citation": citation, "precision": precision,
         "casadi": ca.__version__, "finite_check": finite_check,

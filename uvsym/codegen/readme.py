@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["package_readme"]
+__all__ = ["package_readme", "target_lines"]
 
 
 def _argument_rows(function: dict) -> list[str]:
@@ -26,6 +26,56 @@ def _function_section(function: dict, real: str) -> str:
     table = ["| | argument | size | what | entries [unit] |", "|---|---|---|---|---|", *_argument_rows(function)]
     return (f"### `{function['c_function']}`\n\n{function['description']}.\n\n"
             f"```c\nint {function['c_function']}({', '.join(arguments)});\n```\n\n" + "\n".join(table) + "\n")
+
+
+def target_lines(figures: dict) -> list[str]:
+    """The target figures of a manifest (``target``, see :mod:`uvsym.codegen.target_run`) as text lines."""
+    lines = [f"target {figures['target']} ({figures['description']}), {figures['precision']}: "
+             f"flash {figures['flash']} B, RAM {figures['ram']} B (package objects; {figures['compiler']})"]
+    for name, f in figures["functions"].items():
+        bound = (f"{f['stack_bound']} B" if f["stack_bound"] is not None else
+                 f"unbounded ({f['stack_unbounded_reason']})")
+        measured = f", measured {f['stack_measured']} B" if f["stack_measured"] is not None else ""
+        cost = (f", {f['instructions']} instructions per call ({f['instructions'] / figures['clock_mhz']:.1f} us at "
+                f"{figures['clock_mhz']:g} MHz, one per cycle)" if f["instructions"] is not None else "")
+        lines.append(f"  {name}: stack {bound} own code{measured}{cost}; differs from Python by "
+                     f"{f.get('difference', float('nan')):.3g} {figures.get('difference_unit', '')}")
+    return lines
+
+
+def _target_section(manifest: dict) -> str:
+    figures = manifest.get("target")
+    if not figures:
+        return ""
+    build = ("`make target` builds `target/harness.elf` with the flags below and `make run-target` runs it under "
+             f"`qemu-system-arm -machine {figures['qemu_machine']}`" if figures["qemu_machine"] else
+             "`make target` builds `target/harness.elf` and `make run-target` runs it")
+    rows = "\n".join(f"| `{name}` | {f['stack_bound']} | {f['stack_measured']} | {f['instructions']} | "
+                      f"{f['difference']:.3g} |" for name, f in figures["functions"].items())
+    libraries = ", ".join(f"`{s}`" for s in figures["library_symbols"]) or "none"
+    check = figures["cppcheck"]
+    cppcheck = ("cppcheck was not installed when this package was built." if check is None else
+                f"{check['version']} (default checks): {len(check['findings'])} findings"
+                + "".join(f"\n- {line}" for line in check["findings"][:20]))
+    return f"""
+## Target: {figures['target']}
+
+{figures['description']}. {build}; `cmake -DCMAKE_TOOLCHAIN_FILE=target/toolchain.cmake` uses the
+same compiler and flags: `{' '.join(figures['flags'])}`. The harness (`target/harness.c`, with
+`target/board.c`: startup, semihosting output, no heap) calls every function on its test vectors
+and prints each output's bits. Measured when this package was written ({figures['compiler']}):
+flash {figures['flash']} bytes (text, rodata and data of the package's objects), RAM {figures['ram']}
+bytes (data and bss: the static work arrays). Stack: the bound of the package's own code from
+`-fstack-usage` and the call graph, and the high-water mark measured under qemu (with the C
+library's frames); instructions per call: the largest over the vectors, counted with qemu's
+`-icount`. Difference from CasADi's evaluation: {figures['difference_unit']}.
+
+| function | stack bound [B] | stack measured [B] | instructions per call | difference |
+|---|---|---|---|---|
+{rows}
+
+C library symbols the package needs: {libraries}. {cppcheck}
+"""
 
 
 def package_readme(manifest: dict) -> str:
@@ -92,4 +142,4 @@ function is not reentrant and not thread-safe: do not call the same function fro
 at once (serialise the calls, e.g. with a mutex). Different functions have separate work arrays.
 All external names start with `{name}` (macros with `{name.upper()}_`), so several uvsym packages
 link into one program.
-"""
+""" + _target_section(manifest)
