@@ -140,3 +140,39 @@ def test_under_load_the_rotor_resistance_rise_moves_only_the_speed():
         assert row["speed_change_rad_per_s"] == pytest.approx(-float(rise) * slip / 2.0, rel=1e-9)
         assert row["mimicking_offset_rad_per_s"] == pytest.approx(float(rise) * slip / 4.0, rel=1e-9)
     assert i_sq > 30.0  # a loaded point: rotor current flows
+
+
+@pytest.fixture(scope="module")
+def loaded_target():
+    from derivations.motor_hybrid_observer.torque_balance import loaded_run
+
+    return loaded_run()  # 20 N m, Rr +100 % over the run, 1 rad/s fault at 1 s, unknown start
+
+
+def test_torque_balance_estimate_is_within_1_percent_at_20_N_m_with_double_rotor_resistance(loaded_target):
+    e = loaded_target["estimate"]
+    assert e.detected_at is not None and 1.0 <= e.detected_at < 1.01 and e.unexplained_at is None
+    assert abs(e.final - 1.0) < 0.01  # the slip-based bias would be 1.31 rad/s (identifiability test)
+
+
+def test_an_unknown_load_step_is_flagged_and_not_absorbed_and_a_healthy_run_raises_nothing():
+    from derivations.motor_hybrid_observer.torque_balance import TORQUE_TOLERANCE, loaded_run
+
+    step = loaded_run(load_step=5.0, fault=0.0, duration=5.0)["estimate"]
+    assert step.unexplained_at is not None and step.final is None  # withdrawn, not a -55 rad/s "sensor fault"
+    assert TORQUE_TOLERANCE < 5.0
+    healthy = loaded_run(fault=0.0, duration=5.0)["estimate"]
+    assert healthy.detected_at is None and healthy.unexplained_at is None and healthy.final == 0.0
+
+
+def test_residual_sigma_matches_the_noise_it_is_stated_for():
+    from derivations.motor_hybrid_observer.torque_balance import estimate, residual_sigma
+
+    motor = uvsym.plant("induction_motor", T_L=20.0)
+    rng = np.random.default_rng(5)
+    n, dt = 40000, 1e-4
+    t = np.arange(n) * dt
+    y = np.tile(motor.x_op[[0, 1, 4]], (n, 1)) + rng.normal(0, [0.05, 0.05, 0.02], (n, 3))
+    e = estimate(t, y, np.tile(motor.u_op, (n, 1)), motor, 0.02, 0.05)
+    r = (y[:, 2] - e.omega_hat)[t >= 1.0]
+    assert np.std(r) == pytest.approx(residual_sigma(motor, 0.02, 0.05), rel=0.03)

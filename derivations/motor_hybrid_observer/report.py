@@ -15,6 +15,7 @@ from derivations.motor_hybrid_observer.experiment import CASES, DURATION, run_ca
 from derivations.motor_hybrid_observer.identifiability import indistinguishable_offsets
 from derivations.motor_hybrid_observer.observer_sets import motor_hybrid
 from derivations.motor_hybrid_observer.text import report_text
+from derivations.motor_hybrid_observer.torque_balance import loaded_results
 from uvsym.report import save_svg, write_json
 from uvsym.report.sections import c_package, claim_rows
 
@@ -194,7 +195,9 @@ def build(out_dir: Path, progress) -> None:
     c = c_package(motor_hybrid(), out_dir / "c")
     campaign = campaign_results(progress)
     progress("loaded operating point: equilibria with the rotor resistance raised")
-    results = _results(cases) | {"loaded_identifiability": indistinguishable_offsets(), "c": c,
+    progress("loaded operating point: the torque-balance estimator's variants")
+    results = _results(cases) | {"loaded_identifiability": indistinguishable_offsets(),
+                                 "torque_balance": loaded_results(), "c": c,
                                  "claims": claim_rows(claims),
                                  "claim_evidence": [c.counterexample for c in claims], "campaign": campaign}
     write_json(out_dir / "results.json", results)
