@@ -191,6 +191,6 @@ def output_file(path, what: str, overwrite: bool = False) -> Path:
     if path.is_dir():
         raise PathError(f"cannot write {what} to {path}: it is a folder")
     if path.exists() and not overwrite:
-        raise PathError(f"{path} exists; refusing to overwrite it (pass overwrite=True, or --force)")
+        raise PathError(f"{path} exists; refusing to overwrite it (--force; overwrite=True in Python)")
     make_folder(path.parent, what)
     return path

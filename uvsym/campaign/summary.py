@@ -142,60 +142,48 @@ def _label(value) -> str:
 
 
 def _figures(folder: Path, summary: dict, rows: list[dict]) -> None:
-    from uvsym.report.figures import plt, save_svg  # here: a campaign's worker processes never draw
+    """confusion.svg, roc.svg and delays.svg in uvsym's figure style (:mod:`uvsym.report.style`)."""
+    from uvsym.report.figures import figure_style, plt, save_svg  # here: a campaign's worker processes never draw
+    from uvsym.report.style import confusion_matrix, delay_histograms, roc_curves
 
-    labels_true = list(summary["confusion"])
-    labels_isolated = sorted({k for cell in summary["confusion"].values() for k in cell})
-    fig, ax = plt.subplots(figsize=(5.5, 4.5))
-    if labels_true:
-        counts = np.array([[summary["confusion"][t].get(i, 0) for i in labels_isolated] for t in labels_true])
-        ax.imshow(counts, cmap="Blues")
-        for (y, x), count in np.ndenumerate(counts):
-            ax.text(x, y, str(count), ha="center", va="center",
-                    color="white" if count > counts.max() / 2 else "black")
-        ax.set_xticks(range(len(labels_isolated)), labels_isolated)
-        ax.set_yticks(range(len(labels_true)), labels_true)
-    ax.set_xlabel("isolated target")
-    ax.set_ylabel("true fault")
-    ax.set_title("confusion matrix (runs)")
-    fig.tight_layout()
-    save_svg(fig, folder / "confusion.svg")
-
-    fig, ax = plt.subplots(figsize=(5.5, 4.5))
-    points = sorted((p["false_alarm_rate"], p["detection_probability"], ", ".join(map(_label, p["group"].values())))
-                    for p in summary["roc"]
-                    if p["detection_probability"] is not None and p["false_alarm_rate"] is not None)
-    ax.plot([p[0] for p in points], [p[1] for p in points], "o-", label="all detectors")
-    for detector in summary["detectors"]:
-        own = sorted((p["detectors"][detector]["false_alarm_rate"], p["detectors"][detector]["detection_probability"])
-                     for p in summary["roc"] if p["detectors"][detector]["detection_probability"] is not None
-                     and p["detectors"][detector]["false_alarm_rate"] is not None)
-        ax.plot([q[0] for q in own], [q[1] for q in own], "s--", label=detector)
-    if summary["detectors"]:
-        ax.legend(fontsize=8, loc="lower right")
-    for x, y, label in points:
-        ax.annotate(label, (x, y), xytext=(-4 if x > 0.5 else 4, 4), textcoords="offset points", fontsize=8,
-                    ha="right" if x > 0.5 else "left")
-    ax.plot([0, 1], [0, 1], ":", color="grey")
-    ax.set_xlim(-0.02, 1.02)
-    ax.set_ylim(-0.02, 1.02)
-    ax.set_xlabel("false-alarm rate")
-    ax.set_ylabel("detection probability")
-    ax.set_title("ROC" + (f" over {', '.join(summary['roc_by'])}" if summary["roc_by"] else ""))
-    fig.tight_layout()
-    save_svg(fig, folder / "roc.svg")
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
-    for ax, column in zip(axes, ("detection_delay_s", "isolation_delay_s")):
-        values = [r[column] for r in rows if r["status"] == "ok" and r[column] is not None]
-        if values:
-            ax.hist(values, bins=min(30, max(5, len(values) // 5)))
+    with figure_style():
+        labels_true = list(summary["confusion"])
+        labels_isolated = sorted({k for cell in summary["confusion"].values() for k in cell})
+        fig, ax = plt.subplots(figsize=(2.6 + 0.5 * max(len(labels_isolated), 2), 1.6 + 0.4 * max(len(labels_true), 2)))
+        if labels_true:
+            counts = np.array([[summary["confusion"][t].get(i, 0) for i in labels_isolated] for t in labels_true])
+            confusion_matrix(ax, counts, labels_true, labels_isolated, "true fault target", "isolated target")
         else:
-            ax.text(0.5, 0.5, "none", ha="center", va="center", transform=ax.transAxes)
-        ax.set_xlabel(column.replace("_s", " (s)").replace("_", " "))
-        ax.set_ylabel("runs")
-    fig.tight_layout()
-    save_svg(fig, folder / "delays.svg")
+            ax.text(0.5, 0.5, "no run finished", ha="center", va="center", transform=ax.transAxes)
+            ax.set_axis_off()
+        ax.set_title("Confusion matrix (runs)")
+        save_svg(fig, folder / "confusion.svg")
+
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        curves, labels = {}, {}
+        for name, rates in [("all detectors", lambda p: p)] + [(d, lambda p, d=d: p["detectors"][d])
+                                                               for d in summary["detectors"]]:
+            points = sorted((rates(p)["false_alarm_rate"], rates(p)["detection_probability"],
+                             ", ".join(map(_label, p["group"].values()))) for p in summary["roc"]
+                            if rates(p)["detection_probability"] is not None
+                            and rates(p)["false_alarm_rate"] is not None)
+            curves[name] = ([q[0] for q in points], [q[1] for q in points])
+            labels[name] = [q[2] for q in points]
+        roc_curves(ax, curves, labels if summary["roc_by"] else None)
+        ax.set_title("ROC" + (f" over {', '.join(summary['roc_by'])}" if summary["roc_by"] else ""))
+        save_svg(fig, folder / "roc.svg")
+
+        ok = [r for r in rows if r["status"] == "ok"]
+        names = summary["detectors"] or [None]
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.4), squeeze=False)
+        for ax, column, what in zip(axes[0], ("detection_delay_s", "isolation_delay_s"),
+                                    ("detection delay after the onset", "isolation delay after the onset")):
+            delays = {name or "all detectors": [r.get(column if name is None else f"{name}:{column}") for r in ok]
+                      for name in names}
+            seen = [v for vs in delays.values() for v in vs if v is not None]
+            width = max(float(np.ptp(seen)) / 20, 0.05) if seen else 1.0
+            delay_histograms(ax, delays, bin_width=float(f"{width:.1g}"), unit="s", what=what)
+        save_svg(fig, folder / "delays.svg")
 
 
 def write_report(folder, summary: dict, rows: list[dict], description: str = "") -> Path:

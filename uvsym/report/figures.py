@@ -1,4 +1,5 @@
-"""Deterministic SVG figures: the same data give byte-identical files."""
+"""Deterministic figures in uvsym's style (:mod:`uvsym.report.style`): the same data give
+byte-identical SVG files, and a PNG beside the SVG where a paper wants a raster."""
 
 from __future__ import annotations
 
@@ -9,11 +10,18 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-__all__ = ["save_svg"]
+from uvsym.report.style import RC, figure_style, finish  # noqa: E402
+
+__all__ = ["figure_style", "plt", "save_svg"]
 
 
-def save_svg(fig, path: Path) -> None:
-    """Save a matplotlib figure as SVG without date or random ids, then close it."""
-    with matplotlib.rc_context({"svg.hashsalt": "uvsym", "svg.fonttype": "path"}):
+def save_svg(fig, path: Path, png: bool = False) -> None:
+    """Lay out ``fig`` in uvsym's style (:func:`~uvsym.report.style.finish`), save it as SVG without
+    date or random ids (and, if ``png``, as PNG at ``RC["savefig.dpi"]`` beside it), then close it."""
+    path = Path(path)
+    finish(fig)
+    with matplotlib.rc_context({"svg.hashsalt": RC["svg.hashsalt"], "svg.fonttype": RC["svg.fonttype"]}):
         fig.savefig(path, format="svg", metadata={"Date": None, "Creator": None})
+    if png:
+        fig.savefig(path.with_suffix(".png"), format="png", dpi=RC["savefig.dpi"], metadata={"Software": None})
     plt.close(fig)

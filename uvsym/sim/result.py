@@ -164,14 +164,18 @@ class SimResult:
         Default signals: states, commands and fault estimates of a scenario run; states, inputs
         and every block's published signals of a wired loop (a command drawn once, as the plant
         input, where no actuator fault makes the two differ). Every panel marks the faults' onsets
-        (dashed red; whole-run sensor noise is not a fault) and the detectors' alarms (detected,
+        (dashed vermillion; whole-run sensor noise is not a fault) and the detectors' alarms (detected,
         isolated or identified: dotted black), from the result's meta and decision log."""
         if path is not None:
             path = self.check_plot_path(path, overwrite)
-        import matplotlib
+        from uvsym.report.figures import figure_style, plt, save_svg
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        with figure_style():
+            return self._plot(plt, save_svg, path, names)
+
+    def _plot(self, plt, save_svg, path, names):
+        """The figure of :meth:`plot`, drawn in uvsym's style."""
+        from uvsym.report.style import finish
 
         if not names and "u_command" in self.signals:  # the marine scenario loop
             names = tuple(n for n in ("x", "u_command", "u_actual") if n in self.signals) + tuple(
@@ -188,33 +192,30 @@ class SimResult:
                     continue  # a command the plant input shows as it is (no actuator fault on it)
                 scale, shown = (180.0 / np.pi, unit.replace("rad", "deg")) if "rad" in unit else (1.0, unit)
                 groups.setdefault(shown, []).append((label, scale * column))
-            panels += [(f"{name} ({unit})", lines) for unit, lines in groups.items()]
+            panels += [(name, unit, lines) for unit, lines in groups.items()]
         fig, axes = plt.subplots(len(panels), 1, figsize=(9, 1.9 * len(panels)), sharex=True, squeeze=False)
         from uvsym.diagnosis.events import ALARMS  # here: the diagnosis package builds on uvsym.sim
 
         onsets = sorted({f["onset_s"] for kind in ("actuator_faults", "sensor_faults")
                          for f in self.meta.get(kind, ()) if not f.get("kind", "").endswith("noise")})
         alarms = sorted({e["t"] for e in (self.meta.get("events") or ()) if e["event"] in ALARMS})
-        for ax, (title, lines) in zip(axes[:, 0], panels):
+        for ax, (title, unit, lines) in zip(axes[:, 0], panels):
             for label, column in lines:
                 ax.plot(self.t, column, label=label, lw=1)
-            for times, style, what in ((onsets, dict(color="tab:red", ls="--"), "fault onset"),
+            for times, style, what in ((onsets, dict(color="C1", ls="--"), "fault onset"),
                                        (alarms, dict(color="black", ls=":"), "alarm")):
                 for i, when in enumerate(times):
                     ax.axvline(when, lw=0.8, label=what if i == 0 and ax is axes[0, 0] else None, **style)
-            ax.set_title(title, fontsize=9, loc="left")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, ncol=min(len(lines), 6), loc="upper right")
+            ax.set_ylabel(f"{title} ({unit or '-'})")
+            ax.legend()
         axes[-1, 0].set_xlabel("t (s)")
-        fig.tight_layout()
+        finish(fig)
         if path is not None:
-            from uvsym.report.figures import save_svg
-
             try:
                 if path.suffix == ".svg":
                     save_svg(fig, path)
                 else:
-                    fig.savefig(path, dpi=110)
+                    fig.savefig(path)
                     plt.close(fig)
             except OSError as exc:
                 raise PathError(f"cannot write the figure to {path}: {exc.strerror or exc}") from None
