@@ -12,13 +12,12 @@ import tempfile
 from collections import Counter
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, targets
 from derivations.actuator_observers.dock import cross_track_rms, dock_miss
+from derivations.actuator_observers.figures import campaign_confusion_figure, campaign_delay_figure
 from uvsym.campaign import load_campaign, run_campaign
-from uvsym.report import save_svg
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import simulate_scenario
 
@@ -63,8 +62,8 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
                          "median_size_error_rel": float(np.median(errors)) if errors else None,
                          "max_size_error_rel": float(np.max(errors)) if errors else None}
     _write_table(rows, out_dir / "campaign_results.csv")
-    _confusion_figure(confusion, out_dir / "campaign_confusion.svg")
-    _delay_figure(counted, out_dir / "campaign_delays.svg")
+    campaign_confusion_figure(confusion, out_dir / "campaign_confusion.svg")
+    campaign_delay_figure(counted, out_dir / "campaign_delays.svg")
     return {**figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
             "excluded": [{"vehicle": v, "actuator": a, "kind": k, "runs": n}
                          for (v, a, k), n in sorted(excluded.items())],
@@ -91,36 +90,3 @@ def _write_table(rows: list[dict], path: Path) -> None:
         for row in rows:
             writer.writerow(["" if row.get(c) is None else f"{row[c]:.6g}" if isinstance(row.get(c), float)
                              else row.get(c) for c in TABLE_COLUMNS])
-
-
-def _confusion_figure(confusion: Counter, path: Path) -> None:
-    """Heat map: true (kind, actuator) against the decision standing at the end, counted runs."""
-    truths = sorted({t for t, _ in confusion})
-    decisions = sorted({d for _, d in confusion} | set(truths))
-    grid = np.zeros((len(truths), len(decisions)))
-    for (t, d), n in confusion.items():
-        grid[truths.index(t), decisions.index(d)] = n
-    fig, ax = plt.subplots(figsize=(1.0 + 0.42 * len(decisions), 1.2 + 0.32 * len(truths)))
-    ax.imshow(grid, cmap="Blues", aspect="auto")
-    for i, j in zip(*np.nonzero(grid)):
-        ax.text(j, i, f"{int(grid[i, j])}", ha="center", va="center", fontsize=7)
-    ax.set_xticks(range(len(decisions)), decisions, rotation=60, ha="right", fontsize=7)
-    ax.set_yticks(range(len(truths)), truths, fontsize=7)
-    ax.set_xlabel("decided (standing at the end of the run)")
-    ax.set_ylabel("injected fault")
-    ax.set_title("Campaign: identifiable, excited runs", fontsize=9)
-    save_svg(fig, path)
-
-
-def _delay_figure(counted: list[dict], path: Path) -> None:
-    """Histograms of detection and isolation delays (s after onset) over the counted runs."""
-    fig, ax = plt.subplots(figsize=(6, 3.2))
-    for key, label in (("detection_delay_s", "detection"), ("isolation_delay_s", "isolation")):
-        values = [r[key] for r in counted if r[key] is not None]
-        if values:
-            ax.hist(values, bins=np.arange(0.0, max(values) + 0.5, 0.25), alpha=0.6, label=f"{label} ({len(values)})")
-    ax.axvline(5.0, color="k", ls=":", lw=1, label="median target 5 s")
-    ax.set_xlabel("delay after onset (s)")
-    ax.set_ylabel("runs")
-    ax.legend(fontsize=8)
-    save_svg(fig, path)

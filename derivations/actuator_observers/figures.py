@@ -1,4 +1,5 @@
-"""The paper's Figs. 4-8 of the docking runs: path into the dock, actuation, fault estimates."""
+"""The paper's Figs. 4-8 of the docking runs (path into the dock, actuation, fault estimates) and the
+fault campaign's confusion matrix and delays."""
 
 from __future__ import annotations
 
@@ -11,9 +12,11 @@ from derivations.actuator_observers.dock import arrival, dock_miss
 from derivations.actuator_observers.paper import DOCK_RADIUS_M
 from uvsym.observers.supervisor import FaultDiagnosis
 from uvsym.report import save_svg
+from uvsym.report.style import confusion_matrix, delay_histograms
 from uvsym.sim.scenario import Scenario
 
-__all__ = ["actuation_figure", "estimates_figure", "path_figure"]
+__all__ = ["actuation_figure", "campaign_confusion_figure", "campaign_delay_figure", "estimates_figure",
+           "path_figure"]
 
 
 def path_figure(scenario: Scenario, result, title: str, path: Path) -> None:
@@ -40,9 +43,8 @@ def path_figure(scenario: Scenario, result, title: str, path: Path) -> None:
     ax.set_xlabel("east (m)")
     ax.set_ylabel("north (m)")
     ax.set_aspect("equal")
-    ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
+    ax.set_title(title)
+    ax.legend()
     save_svg(fig, path)
 
 
@@ -54,10 +56,9 @@ def actuation_figure(result, title: str, path: Path, t_max: float = 30.0) -> Non
         ax.plot(result.t[keep], scale * result["u_desired"][label][keep], "k--", lw=1, label="desired (controller)")
         ax.plot(result.t[keep], scale * result["u_actual"][label][keep], "C0", lw=1.2, label="actual (delivered)")
         ax.set_ylabel(f"{'thrust X' if label == 'X' else 'upper rudder'} ({unit})")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend()
     axes[-1].set_xlabel("t (s)")
-    axes[0].set_title(title, fontsize=10)
+    axes[0].set_title(title)
     save_svg(fig, path)
 
 
@@ -65,7 +66,7 @@ def estimates_figure(result, diagnosis: FaultDiagnosis, path: Path, t_max: float
     """Fault estimates, predicted faults and isolation times of thruster and rudder (Fig. 6)."""
     iso = diagnosis.isolator.result
     keep, keep_iso = result.t <= t_max, iso.t <= t_max
-    fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 6), sharex=True)
     panels = (("X", "proportional", "thruster: proportional factor (-)"), ("X", "bias", "thruster: bias (N)"),
               ("N", "proportional", "rudder: proportional factor (-)"), ("N", "bias", "rudder: bias (N m)"))
     for ax, (channel, kind, title) in zip(axes.ravel(), panels):
@@ -78,9 +79,34 @@ def estimates_figure(result, diagnosis: FaultDiagnosis, path: Path, t_max: float
         finite = result[f"f_hat/{kind}"][channel][keep]
         low, high = np.nanpercentile(finite, [2, 98])
         ax.set_ylim(low - 0.2 * (high - low + 1e-3), high + 0.2 * (high - low + 1e-3))
-        ax.set_title(f"{title} [{channel} channel]", fontsize=9)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.set_title(f"{title} [{channel} channel]")
+        ax.set_ylabel(title.split(": ")[1])
+        ax.legend()
     for ax in axes[-1]:
         ax.set_xlabel("t (s)")
+    save_svg(fig, path)
+
+
+def campaign_confusion_figure(confusion, path: Path) -> None:
+    """Counted runs: true (kind, actuator) against the decision standing at the end of the run."""
+    truths = sorted({t for t, _ in confusion})
+    decisions = sorted({d for _, d in confusion} | set(truths))
+    grid = np.zeros((len(truths), len(decisions)))
+    for (t, d), n in confusion.items():
+        grid[truths.index(t), decisions.index(d)] = n
+    fig, ax = plt.subplots(figsize=(2.8 + 0.45 * len(decisions), 2.0 + 0.3 * len(truths)))
+    confusion_matrix(ax, grid, truths, decisions, "true (injected fault)", "decided (standing at the end of the run)")
+    ax.set_title("Campaign: identifiable, excited runs")
+    save_svg(fig, path)
+
+
+def campaign_delay_figure(counted: list[dict], path: Path, target_s: float = 5.0) -> None:
+    """Detection and isolation delays (s after the onset) of the counted runs, side by side, and the
+    median target."""
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    delay_histograms(ax, {what: [r[key] for r in counted] for key, what in
+                          (("detection_delay_s", "detection"), ("isolation_delay_s", "isolation"))},
+                     bin_width=0.25, unit="s", what="delay after the onset")
+    ax.axvline(target_s, color="k", ls=":", lw=1, label=f"median target {target_s:g} s")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     save_svg(fig, path)

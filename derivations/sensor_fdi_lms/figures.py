@@ -10,6 +10,7 @@ import numpy as np
 
 from derivations.sensor_fdi_lms.design import EPS0_DEG2, FAULT_SAMPLE, R0, SET_POINT_DEG
 from uvsym.report import save_svg
+from uvsym.report.style import delay_histograms, roc_curves
 
 __all__ = ["criteria_figure", "heading_figure", "roc_figure", "delay_figure"]
 
@@ -36,9 +37,9 @@ def criteria_figure(outcome, path: Path) -> None:
     bottom.set_xlabel("recorded sample k (0.2 s)")
     for ax in (top, bottom):
         ax.axvline(FAULT_SAMPLE, color="k", lw=0.6, ls=":")
-        ax.legend(fontsize=8, loc="upper left")
+        ax.legend()
     top.set_title(f"Compass fault of +{outcome.spec.size_deg:g} deg at sample {FAULT_SAMPLE}: both criteria",
-                  fontsize=9)
+)
     save_svg(fig, path)
 
 
@@ -61,33 +62,26 @@ def heading_figure(outcomes: dict, path: Path, title: str, substitute: bool) -> 
     ax.axvline(FAULT_SAMPLE, color="k", lw=0.6, ls=":")
     ax.set_xlabel("recorded sample k (0.2 s)")
     ax.set_ylabel("heading (deg)")
-    ax.legend(fontsize=7, loc="lower left")
-    ax.set_title(title, fontsize=9)
+    ax.legend()
+    ax.set_title(title)
     save_svg(fig, path)
 
 
 def roc_figure(roc: dict, path: Path) -> None:
     """Detection probability against false-alarm rate of the three detectors over their thresholds."""
-    fig, ax = plt.subplots(figsize=(5, 4.5))
-    for (name, curve), style in zip(roc.items(), ("C0o-", "C3s-", "C2^-")):
-        ax.plot(curve["false_alarm_rate"], curve["detection_probability"], style, ms=3, lw=1, label=name)
-    ax.plot([0, 1], [0, 1], color="grey", lw=0.6, ls=":")
-    ax.set_xlabel("false-alarm rate (one-sample disturbance runs)")
-    ax.set_ylabel("detection probability (10 deg fault runs)")
-    ax.set_xlim(-0.02, 1.02)
-    ax.set_ylim(-0.02, 1.02)
-    ax.legend(fontsize=8, loc="lower right")
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    roc_curves(ax, {name: (curve["false_alarm_rate"], curve["detection_probability"]) for name, curve in roc.items()})
+    ax.set_xlabel("false-alarm rate (fraction of one-sample disturbance runs)")
+    ax.set_ylabel("detection probability (fraction of 10 deg fault runs)")
+    ax.set_title("ROC of the three detectors over their thresholds")
     save_svg(fig, path)
 
 
 def delay_figure(delays: dict, path: Path) -> None:
-    """Histogram of the detection delay (samples after the onset) of each detector at its nominal thresholds."""
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    top = max([max(v["delays"], default=0) for v in delays.values()] + [1])
-    bins = np.arange(-0.5, top + 1.5)
-    for (name, value), colour in zip(delays.items(), ("C0", "C3", "C2")):
-        ax.hist(value["delays"], bins=bins, histtype="step", color=colour, lw=1.4, label=name)
-    ax.set_xlabel("detection delay (samples of 0.2 s after the onset)")
-    ax.set_ylabel("runs")
-    ax.legend(fontsize=8)
+    """Runs per detection delay (samples after the onset) of each detector at its nominal thresholds,
+    the detectors' bars side by side."""
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    delay_histograms(ax, {name: value["delays"] for name, value in delays.items()}, bin_width=1.0,
+                     unit="samples of 0.2 s")
+    ax.set_title("Detection delay at the nominal thresholds")
     save_svg(fig, path)

@@ -200,7 +200,7 @@ def delay_histograms(ax, delays: Mapping[str, Sequence[float]], bin_width: float
     values = {name: np.asarray([v for v in vs if v is not None], dtype=float) for name, vs in delays.items()}
     seen = [v for v in values.values() if v.size]
     low = min([0.0] + [np.floor(v.min() / bin_width) * bin_width for v in seen])
-    edges = np.arange(low, max([v.max() for v in seen] + [low + bin_width]) + bin_width, bin_width)
+    edges = np.arange(low, max([v.max() for v in seen] + [low]) + 1.5 * bin_width, bin_width)
     width = bin_width / max(len(values), 1)
     for k, (name, v) in enumerate(values.items()):
         counts, _ = np.histogram(v, bins=edges)
