@@ -35,9 +35,9 @@ def _thrust(result: SimResult, faults: tuple[ThrusterFault, ...], path: Path) ->
         ax.plot(t, result["guidance"][name][::STRIDE], "k", lw=0.8, label=f"command {name} (bar)")
         ax.plot(t, result["u"][name][::STRIDE], "C1", lw=0.8, label=f"delivered {name}")
         ax.set_ylabel("thrust (N)")
-        ax.legend(fontsize=7, loc="lower left")
+        ax.legend()
     axes[-1].set_xlabel("time (s)")
-    axes[0].set_title("Thrust commands and delivered thrust; fault windows shaded", fontsize=9)
+    axes[0].set_title("Thrust commands and delivered thrust; fault windows shaded")
     save_svg(fig, path)
 
 
@@ -53,7 +53,7 @@ def _states(result: SimResult, faults: tuple[ThrusterFault, ...], path: Path, wa
     top.set_xlabel("east (m)")
     top.set_ylabel("north (m)")
     top.set_aspect("equal")
-    top.legend(fontsize=7, loc="center")
+    top.legend()
     t = result.t[::STRIDE]
     for state, unit in (("psi", "rad"), ("v", "m/s")):
         ax = axes[state]
@@ -62,9 +62,8 @@ def _states(result: SimResult, faults: tuple[ThrusterFault, ...], path: Path, wa
         for method, label, colour in BANKS:
             ax.plot(t, result[method][f"{state}_hat"][::STRIDE], colour, lw=0.6, ls="--", label=label)
         ax.set_ylabel(f"{state} ({unit})")
-        ax.legend(fontsize=6)
+        ax.legend()
     axes["v"].set_xlabel("time (s)")
-    fig.tight_layout()
     save_svg(fig, path)
 
 
@@ -77,7 +76,7 @@ def _errors(result: SimResult, faults: tuple[ThrusterFault, ...], path: Path) ->
             error = result[method][f"{state}_hat"] - result["x"][state]
             ax.plot(t, error[::STRIDE], colour, lw=0.6, label=label)
         ax.set_ylabel(f"{state} error ({unit})")
-        ax.legend(fontsize=7)
+        ax.legend()
     axes[-1].set_xlabel("time (s)")
     save_svg(fig, path)
 
@@ -96,7 +95,7 @@ def _efficiency(result: SimResult, faults: tuple[ThrusterFault, ...], path: Path
                     lw=0.7, label=f"{label}: {side} model's estimate")
         ax.set_ylabel(f"alpha {thruster} (-)")
         ax.set_ylim(0.0, 2.5)
-        ax.legend(fontsize=7, loc="lower left")
+        ax.legend()
     axes[-1].set_xlabel("time (s)")
     save_svg(fig, path)
 
@@ -110,7 +109,7 @@ def _probabilities(result: SimResult, faults: tuple[ThrusterFault, ...], path: P
         for model, colour in (("nofault", "k"), ("left", "C0"), ("right", "C3")):
             ax.plot(t, bank[f"p_{model}"][::STRIDE], colour, lw=0.8, label=f"p {model}")
         ax.set_ylabel(f"{label}\nprobability")
-        ax.legend(fontsize=7, loc="center left")
+        ax.legend()
     axes[-1].set_xlabel("time (s)")
     save_svg(fig, path)
 
