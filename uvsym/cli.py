@@ -374,6 +374,7 @@ def _claim_block(row: dict, width: int = 100) -> str:
 def _cmd_verify(args) -> int:
     import time
 
+    from uvsym.progress import ProgressBar
     from uvsym.report.markdown import write_json
     from uvsym.verify.certificate import STATUSES
 
@@ -405,9 +406,13 @@ def _cmd_verify(args) -> int:
     if studies or not scenario_files:
         chosen = [s for s in _selected(studies) if s.claims is not None]
         folders = [claimed(study.name) for study in chosen]  # every folder checked before any claim runs
-        for study, out_dir in zip(chosen, folders):
+        bar = ProgressBar("verify", total=len(chosen), unit="derivations", interval_s=0.0)
+        for index, (study, out_dir) in enumerate(zip(chosen, folders)):
+            print(f"[{index + 1}/{len(chosen)}] {study.name}: checking its claims", file=sys.stderr, flush=True)
             started = time.perf_counter()
             record(out_dir, study.name, study.claims(), time.perf_counter() - started)
+            bar((index + 1) / len(chosen))
+            bar.close()  # one line per derivation: its claims print next
     for source in scenario_files:
         from uvsym.scenario_exports import scenario_claims
 
@@ -441,22 +446,16 @@ def _cmd_campaign(args) -> int:
         print(f"{campaign.name}: {len(campaign.runs)} runs in {len({r.case for r in campaign.runs})} cases, every "
               f"scenario valid; fields: {', '.join(campaign.columns) or 'none'}")
         return 0
-    bar, drawn = ProgressBar(campaign.name), []
-
-    def progress(fraction: float) -> None:
-        drawn.append(fraction)
-        bar(fraction)
+    bar = ProgressBar(campaign.name, unit="runs")  # counts of the runs to run: set by run_campaign
 
     def log(line: str) -> None:
-        if drawn:
-            bar.close()
-            drawn.clear()
+        bar.close()
         print(line, file=sys.stderr, flush=True)
 
     out = Path(args.out) if args.out else default_out(campaign)
     try:
         run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
-                     chunk_size=args.chunk_size, progress=progress, force=args.force, log=log)
+                     chunk_size=args.chunk_size, progress=bar, force=args.force, log=log)
     except KeyboardInterrupt:
         log(f"interrupted: the finished chunks are kept in {out / 'chunks'}; run the same command to resume")
         return 130

@@ -18,6 +18,7 @@ from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, t
 from derivations.actuator_observers.dock import cross_track_rms, dock_miss
 from derivations.actuator_observers.figures import campaign_confusion_figure, campaign_delay_figure
 from uvsym.campaign import load_campaign, run_campaign
+from uvsym.progress import ProgressBar
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import simulate_scenario
 
@@ -44,7 +45,8 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     campaign = load_campaign(CAMPAIGN)
     progress(f"fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+                            progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
     figures = counts(rows)
     faulty = [r for r in rows if r["status"] == "ok" and r["true_actuator"] is not None]
     counted = [r for r in faulty if r["identifiable"] and r["excited"]]

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_rates
+from uvsym.progress import ProgressBar
 
 __all__ = ["CAMPAIGN", "DETECTORS", "campaign_results", "figures"]
 
@@ -71,5 +72,6 @@ def campaign_results(progress, workers: int | None = None) -> dict:
     campaign = load_campaign(CAMPAIGN)
     progress(f"fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+                            progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
     return figures(rows)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_rates
+from uvsym.progress import ProgressBar
 
 __all__ = ["CAMPAIGN", "DETECTORS", "campaign_results"]
 
@@ -63,7 +64,8 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     campaign = load_campaign(CAMPAIGN)
     progress(f"compass-fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+                            progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
     _write_table(rows, out_dir / "campaign_results.csv")
     cases: dict[str, list[dict]] = {}
     for row in rows:

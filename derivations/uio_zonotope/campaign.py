@@ -16,6 +16,7 @@ import numpy as np
 
 from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_rates
+from uvsym.progress import ProgressBar
 
 __all__ = ["CAMPAIGN", "DETECTOR", "campaign_results", "metrics", "section"]
 
@@ -79,7 +80,8 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     campaign = load_campaign(CAMPAIGN)
     progress(f"campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+                            progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
     for row in rows:
         row["noise_level"] = _level(row)
     with open(out_dir / "campaign_results.csv", "w", newline="") as handle:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_names, detector_rates
+from uvsym.progress import ProgressBar
 from uvsym.report import markdown_table
 
 __all__ = ["CAMPAIGN", "run_study_campaign", "campaign_section"]
@@ -67,7 +68,8 @@ def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict
     campaign = load_campaign(CAMPAIGN)
     progress(f"campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers).to_pylist()
+        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+                            progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
     detectors = detector_names(rows)
     cases = list(dict.fromkeys(r["case"] for r in rows))
     figures = {

@@ -44,7 +44,8 @@ def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: in
 
     executor: None (the campaign's [executor]), "local", "dask", or an object with start, run and
     close (:mod:`uvsym.campaign.executors`); workers, scheduler and chunk_size override the
-    campaign's. progress: called with the fraction (0..1) of this call's runs finished; log: called
+    campaign's. progress: called with the fraction (0..1) of this call's runs finished (its ``total``, where it
+    has one, as a :class:`~uvsym.progress.ProgressBar` has, set to their number first); log: called
     with one line of text per step. Returns the results table (pyarrow; one row per finished run,
     in the campaign's order; ``table.to_pylist()`` gives dicts). Every check (folder, metrics hook,
     scheduler) happens before the first run.
@@ -58,6 +59,8 @@ def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: in
                                  scheduler=options["scheduler"], timeout_s=options["timeout_s"])
     done = store.finished()
     todo = [run for run in campaign.runs if run.id not in done]
+    if hasattr(progress, "total"):  # a ProgressBar shows counts of the runs to run
+        progress.total = len(todo)
     size = options["chunk_size"]
     chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
     say(f"{campaign.name}: {len(campaign.runs)} runs, {len(campaign.runs) - len(todo)} finished before, "
