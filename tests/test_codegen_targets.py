@@ -75,8 +75,6 @@ def test_the_package_runs_on_the_target_as_python_computes(built, name, target, 
         both_nan = np.isnan(expected) & np.isnan(got[k])
         error = np.where(both_nan, 0.0, np.abs(got[k] - expected)) / scale
         bound = DOUBLE_ULPS * 2.0**-52 if precision == "double" else FLOAT_TOLERANCE
-        if precision == "float" and v.source.startswith("seeded"):
-            continue  # float is promised on the set's example only (random states may be stiff for it)
         assert np.all(error <= bound), (e.function.name(), float(np.nanmax(error)))
     figures = manifest["target"]
     assert figures["flash"] > 0 and figures["ram"] > 0

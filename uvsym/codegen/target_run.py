@@ -14,7 +14,8 @@ that target (:mod:`uvsym.codegen.targets`) with ``-Wall -Wextra -Werror``, then 
   virtual clock by a fixed time per instruction, the harness reads the board's timer around each
   call and calibrates ticks per instruction on a loop of known length (bare metal only);
 - the C library symbols the package objects need (``nm -u``), refused when one allocates or
-  does I/O (``FORBIDDEN``), and the findings of ``cppcheck`` (default checks) when installed;
+  does I/O (``FORBIDDEN``), and the findings of ``cppcheck`` (default checks, one preprocessor
+  configuration; its information messages left out) when installed;
 - each call's outputs, decoded from their bits, with their return codes, and how far they are
   from CasADi's evaluation of the same vectors (:func:`differences`): a double build in units
   of the last place (2^-52) of each output's scale ``max(1, max|Python|)``, a float build relative
@@ -138,11 +139,12 @@ def _cppcheck(package_dir: Path, name: str) -> dict | None:
     """cppcheck's default checks on the package sources: its version and findings (None: not installed)."""
     if shutil.which("cppcheck") is None:
         return None
-    done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--template={file}:{line}: {severity}: {message} [{id}]",
-                           "-Iinclude", f"src/{name}_casadi.c", f"src/{name}.c"], cwd=package_dir,
+    done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1",
+                           "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
+                           f"src/{name}_casadi.c", f"src/{name}.c"], cwd=package_dir,
                           capture_output=True, text=True, timeout=600)
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
-    findings = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: \w+: ", line)]
+    findings = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: (?!information)\w+: ", line)]
     return {"version": version, "findings": findings}
 
 
