@@ -1,8 +1,9 @@
 """The shipped docking scenario with a thruster bias and a rudder fault, varied: a larger rudder fault.
 
-Loads the scenario, changes the rudder's proportional factor from the shipped value to 0.5,
-simulates with the compiled fast path, prints the observers' converged estimates and writes the
-result (.npz) and a quick-look figure into a folder of your choice (default: a temporary one).
+Loads the scenario, changes the proportional factor of both rudders (upper and lower, 0.8 as
+shipped) to 0.5, simulates with the compiled fast path, prints the observers' converged estimates
+and writes the result (.npz) and a quick-look figure into a folder of your choice (default: a
+temporary one).
 
 Run: python examples/docking_with_faults.py [OUTPUT_FOLDER]
 """

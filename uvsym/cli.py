@@ -281,11 +281,20 @@ def _is_scenario_file(name: str) -> bool:
     return name.endswith(".toml") or Path(name).is_file() or name in every_shipped_scenario()
 
 
+def _first_sentence(doc: str | None) -> str:
+    """A docstring's first sentence as plain text: its first paragraph joined into one line, up to the
+    first full stop that ends a sentence, without reStructuredText's backticks."""
+    import re
+
+    paragraph = " ".join((doc or "").strip().split("\n\n")[0].split()).replace("``", "").replace("`", "")
+    return re.split(r"(?<=[a-z0-9)][.!?])\s+(?=[A-Z(])", paragraph, maxsplit=1)[0]
+
+
 def _cmd_codegen(args) -> int:
     from uvsym.codegen.observer_sets import option_flags, options_of
 
     if args.list or not args.name:
-        rows = [[name, study, option_flags(options_of(factory)), (factory.__doc__ or "").strip().split("\n")[0]]
+        rows = [[name, study, option_flags(options_of(factory)), _first_sentence(factory.__doc__)]
                 for name, (study, factory) in observer_sets().items()]
         print(_table(rows, ["observer set", "derivation", "options", "description"]))
         return 0

@@ -18,7 +18,7 @@ LIU = paper("liu2014")
 
 
 def _fmt(value, digits: int = 6) -> str:
-    return f"{value:.{digits}g}" if isinstance(value, float) else str(value)
+    return "-" if value is None else f"{value:.{digits}g}" if isinstance(value, float) else str(value)
 
 
 def _derived_gains(scenario: Scenario) -> str:
@@ -211,7 +211,8 @@ def continuous_section(c: dict) -> str:
     kinds = [[k, v["runs"], v["correct"], _fmt(v["median_size_error_rel"], 3), _fmt(v["max_size_error_rel"], 3)]
              for k, v in f["by_kind"].items()]
     wrong = [[w["case"], f"{w['true_kind']} {w['true_actuator']} {_fmt(w['true_value'], 3)}", _fmt(w["onset_s"], 3),
-              f"{w['isolated_kind']} {w['isolated_target']}", _fmt(w["identified_value"], 4),
+              "nothing isolated" if w["isolated_target"] is None else f"{w['isolated_kind']} {w['isolated_target']}",
+              _fmt(w["identified_value"], 4),
               _fmt(w["size_error_rel"], 3)] for w in f["wrong"]]
     excluded = [[e["vehicle"], e["actuator"], e["kind"], e["runs"]] for e in f["excluded"]]
     events = [[_fmt(e["t"], 4), e["event"], e["target"], e["kind"] or "", _fmt(e["value"], 5) if e["value"]

@@ -127,7 +127,8 @@ def lyapunov_decrease(claim: str, vertices: list[np.ndarray], gamma: float, set_
             vertex_ok, vertex_margin = exact_positive_definite(Q)
             ok, margins = ok and vertex_ok, margins + [vertex_margin]
         if ok:
-            return Certificate(claim, set_description, f"LMI (cvxpy, Clarabel) at {len(exact)} vertices, re-checked "
+            where = "1 vertex" if len(exact) == 1 else f"{len(exact)} vertices"
+            return Certificate(claim, set_description, f"LMI (cvxpy, Clarabel) at {where}, re-checked "
                                "by exact rational LDL^T", "proved", expected, margin=float(min(margins)),
                                seconds=time.perf_counter() - started, details={"P": np.asarray(P.value).tolist()})
         failure = "the solver's P failed the exact re-check"
