@@ -100,3 +100,11 @@ def test_the_quick_look_plot_has_no_clipped_text_and_units_on_its_axes(names):
     assert all(ax.get_ylabel().endswith(")") for ax in fig.axes)
     assert fig.axes[-1].get_xlabel() == "t (s)"
     plt.close(fig)
+
+
+def test_saving_a_figure_whose_text_cannot_fit_names_that_text(tmp_path):
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(2, 1.5))
+        ax.set_ylabel("a label far longer than the figure is tall (N m)")
+        with pytest.warns(RuntimeWarning, match="a label far longer"):
+            save_svg(fig, tmp_path / "small.svg")
