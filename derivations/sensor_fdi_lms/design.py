@@ -27,9 +27,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 import uvsym
+from uvsym.errors import ObserverError
 from uvsym.observers.base import Observer
 from uvsym.observers.lms import lms_monitor
 from uvsym.observers.lms_supervisor import switch_flag
+from uvsym.observers.step_monitor import sensor_step_monitor
 from uvsym.sim import observer_block
 from uvsym.sim.blocks import select
 from uvsym.sim.feedback import open_loop, pid
@@ -38,7 +40,9 @@ from uvsym.systems.signals import signals
 from uvsym.systems.system import System
 
 __all__ = ["Design", "design", "DT", "ORDER", "MU", "SET_POINT_DEG", "EPS0_DEG2", "R0", "WINDOW", "HOLD", "CONFIRM",
-           "BANDWIDTH", "COMPASS_NOISE_DEG", "TORQUE_NOISE", "WARM_UP", "RECORD", "FAULT_SAMPLE", "FAULT_SIZES_DEG"]
+           "BANDWIDTH", "COMPASS_NOISE_DEG",
+           "DECISIONS", "STEP_MONITOR", "STEP_FALSE_ALARMS_PER_HOUR",
+           "TORQUE_NOISE", "WARM_UP", "RECORD", "FAULT_SAMPLE", "FAULT_SIZES_DEG"]
 
 # the paper's numbers
 DT = 0.2  # s (L563)
@@ -59,6 +63,9 @@ COMPASS_NOISE_DEG = 0.5  # standard deviation of the compass noise
 TORQUE_NOISE = 1e-4  # N m, standard deviation of the white yaw torque (held over each sample)
 WARM_UP = 500  # samples before the record starts (100 s): the filter trains on the healthy loop
 RECORD = 400  # samples recorded (80 s): the fault at 70 leaves 66 s after it
+DECISIONS = ("paper", "calibrated")  # the double criterion, or the calibrated sensor-step monitor
+STEP_MONITOR = "step"  # the step monitor's block name
+STEP_FALSE_ALARMS_PER_HOUR = 0.1  # designed bound on its false confirmations (the scenario files' too)
 
 
 @dataclass(frozen=True)
@@ -103,11 +110,16 @@ def pi_gains(plant: System) -> tuple[float, float]:
 
 def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0: float = R0, window: int = WINDOW,
            hold: int = HOLD, confirm: int = CONFIRM, set_point_deg: float = SET_POINT_DEG,
-           bandwidth: float = BANDWIDTH, integral: bool = False, substitute_on: str | None = None) -> Design:
+           bandwidth: float = BANDWIDTH, integral: bool = False, substitute_on: str | None = None,
+           decision: str = "paper", noise_deg: float = COMPASS_NOISE_DEG) -> Design:
     """The plant, the monitor and the heading loop's blocks (ObserverError for bad monitor settings);
     ``integral``: the PI law of :func:`pi_gains` instead of the proportional one; substitute_on:
     None (the controller reads the compass), ``"fault"`` or ``"alarm"`` (it reads ``psi_sel``,
-    switched in the same sample by the flag of :func:`uvsym.observers.lms_supervisor.switch_flag`)."""
+    switched in the same sample by the flag of :func:`uvsym.observers.lms_supervisor.switch_flag`);
+    decision ``"calibrated"`` adds the sensor-step monitor (:func:`step_monitor`, told the compass
+    noise ``noise_deg``) and, with substitute_on set, the controller reads its ``psi_sub`` instead."""
+    if decision not in DECISIONS:
+        raise ObserverError(f"decision must be one of {', '.join(DECISIONS)}, got {decision!r}")
     plant = uvsym.plant("rov_yaw")
     monitor = lms_monitor(plant.y, plant.u, reference=signals(("psi_ref", "rad", "heading set-point")),
                           order=order, mu=mu, eps0=eps0_deg2 * (math.pi / 180.0) ** 2, r0=r0, dt=DT, window=window,
@@ -116,12 +128,23 @@ def design(order: int = ORDER, mu: float = MU, eps0_deg2: float = EPS0_DEG2, r0:
     reference = open_loop("reference", [0.0], [math.radians(set_point_deg)], publishes=["psi_ref"])
     blocks = (reference, observer_block(monitor))
     measured = "psi"
-    if substitute_on is not None:
+    if decision == "calibrated":
+        blocks += (observer_block(step_monitor(plant, noise_deg)),)
+        if substitute_on is not None:
+            measured = f"{STEP_MONITOR}.psi_sub"
+    elif substitute_on is not None:
         measured = "psi_sel"
         blocks += (select("ftc", flag=switch_flag("psi", substitute_on), on="psi_sub", off="psi", output=measured,
                           unit=plant.y.unit("psi")),)
     controller = pid("heading", measured, "psi_ref", output="u", kp=kp, ki=ki, limits=(-1.0, 1.0), dt=DT)
     return Design(plant, monitor, kp, (reference, controller) + blocks[1:])
+
+
+def step_monitor(plant: System, noise_deg: float = COMPASS_NOISE_DEG) -> Observer:
+    """The calibrated sensor-step monitor of the compass (:mod:`uvsym.observers.step_monitor`), told its
+    noise (deg), with confirmations designed for ``STEP_FALSE_ALARMS_PER_HOUR``."""
+    return sensor_step_monitor(plant.y, noise_std=math.radians(noise_deg), dt=DT,
+                               false_alarms_per_hour=STEP_FALSE_ALARMS_PER_HOUR, name=STEP_MONITOR)
 
 
 def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:

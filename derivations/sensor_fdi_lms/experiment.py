@@ -47,7 +47,9 @@ class Run:
     recorded sample ``onset``; None size: no fault. ftc: the controller reads the frozen filter's
     substitute, switched in the same sample, once the fault is confirmed (``substitute_on="fault"``)
     or from the first eps^2 alarm to the release (``"alarm"``, Sec. 4.3).
-    bandwidth (rad/s): of the proportional heading law; integral: the PI law instead."""
+    bandwidth (rad/s): of the proportional heading law; integral: the PI law instead. decision:
+    ``"paper"`` (the double criterion switches the substitute) or ``"calibrated"`` (the sensor-step
+    monitor does, :func:`.design.step_monitor`); noise_deg: the compass noise (told to that monitor)."""
 
     size_deg: float | None = 30.0
     onset: int = FAULT_SAMPLE
@@ -66,6 +68,8 @@ class Run:
     r0: float = R0
     bandwidth: float = BANDWIDTH
     integral: bool = False
+    decision: str = "paper"
+    noise_deg: float = COMPASS_NOISE_DEG
 
     def profile_object(self) -> Profile:
         """The fault's time profile in s of loop time."""
@@ -111,10 +115,11 @@ def run(spec: Run) -> Outcome:
     run of 900 samples building C would cost more than it saves). The substitution is switched
     inside the loop (:func:`.design.design`); the supervisor only logs, from the recorded flags."""
     d = design(order=spec.order, mu=spec.mu, eps0_deg2=spec.eps0_deg2, r0=spec.r0, bandwidth=spec.bandwidth,
-               integral=spec.integral, substitute_on=spec.substitute_on if spec.ftc else None)
+               integral=spec.integral, substitute_on=spec.substitute_on if spec.ftc else None,
+               decision=spec.decision, noise_deg=spec.noise_deg)
     plant = d.plant
     samples = spec.warm_up + spec.record
-    faults = [SensorFault(plant.y.index("psi"), "noise", math.radians(COMPASS_NOISE_DEG))]
+    faults = [SensorFault(plant.y.index("psi"), "noise", math.radians(spec.noise_deg))]
     if spec.size_deg is not None:
         faults.append(SensorFault(plant.y.index(spec.sensor), spec.kind, math.radians(spec.size_deg),
                                   spec.profile_object()))

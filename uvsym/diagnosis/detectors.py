@@ -33,6 +33,11 @@ that the value is the sensor's offset in its unit, kind ``bias``).
 :class:`DoubleCriterion` -- the LMS-FIR monitor's own decision (Zhu et al., Sec. 3.2; published
 as ``fault_<y>``): ``detected`` and ``isolated`` on sensor y when its fault flag rises,
 ``cleared`` when it falls.
+
+:class:`StepDecision` -- the calibrated sensor-step monitor's decisions
+(:mod:`uvsym.observers.step_monitor`, its ``fault_<y>`` flag and offset): ``detected``,
+``isolated`` and ``identified`` (kind ``bias``, the confirmed offset) when the flag rises, a new
+``identified`` when a further step changes the offset, ``cleared`` when it falls.
 """
 
 from __future__ import annotations
@@ -44,7 +49,8 @@ import numpy as np
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError
 
-__all__ = ["ResidualThreshold", "DoubleCriterion", "EstimatedFault", "check_samples", "threshold_factor",
+__all__ = ["ResidualThreshold", "DoubleCriterion", "StepDecision", "EstimatedFault", "check_samples", "flag_events",
+           "threshold_factor",
            "read_signal"]
 
 
@@ -63,6 +69,22 @@ def check_samples(detector, *fields: str) -> None:
         value = getattr(detector, what)
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise DiagnosisError(f"detector {detector.name}: {what} must be an integer >= 1 (samples), got {value!r}")
+
+
+def flag_events(result, flag_name: str, target: str, detector: str) -> list[Event]:
+    """``detected`` and ``isolated`` on ``target`` where the logged 0/1 flag ``flag_name`` rises,
+    ``cleared`` where it falls."""
+    t = np.asarray(result.t, dtype=float)
+    flag = read_signal(result, flag_name) > 0.5
+    events = []
+    for k in np.flatnonzero(np.diff(np.concatenate([[False], flag]).astype(int))):
+        time = round(float(t[k]), 9)
+        if flag[k]:
+            events += [Event(time, "detected", target, detector=detector),
+                       Event(time, "isolated", target, detector=detector)]
+        else:
+            events.append(Event(time, "cleared", target, detector=detector))
+    return events
 
 
 def threshold_factor(false_alarms_per_hour: float, dt: float, channels: int) -> float:
@@ -174,24 +196,40 @@ class DoubleCriterion:
         if mu is not None and self.regressor is not None:
             u = read_signal(result, self.regressor)
             check_mu(mu, self.order, float(np.mean(u ** 2)), what=f"{self.monitor}.mu")
-        t = np.asarray(result.t, dtype=float)
-        flag = read_signal(result, f"{self.monitor}.fault_{self.sensor}") > 0.5
-        changes = np.flatnonzero(np.diff(np.concatenate([[False], flag]).astype(int)))
-        events = []
-        for k in changes:
-            time = round(float(t[k]), 9)
-            if flag[k]:
-                events += [Event(time, "detected", self.sensor, detector=self.name),
-                           Event(time, "isolated", self.sensor, detector=self.name)]
-            else:
-                events.append(Event(time, "cleared", self.sensor, detector=self.name))
-        return events
+        return flag_events(result, f"{self.monitor}.fault_{self.sensor}", self.sensor, self.name)
 
     def design(self) -> dict:
         return {"detector": self.name, "rule": "LMS double criterion (eps^2 > eps0 confirmed by R > r0)",
                 "monitor": self.monitor, "sensor": self.sensor, "settings": self.settings,
                 "parameters": dict(self.parameters)}
 
+
+
+@dataclass(frozen=True)
+class StepDecision:
+    """The sensor-step monitor ``monitor``'s decisions on ``sensor`` as events (module docstring);
+    settings: its block's description (the designed rate and threshold)."""
+
+    name: str
+    monitor: str
+    sensor: str
+    settings: str = ""
+
+    def decide(self, result) -> list[Event]:
+        events = flag_events(result, f"{self.monitor}.fault_{self.sensor}", self.sensor, self.name)
+        t = np.asarray(result.t, dtype=float)
+        offset = read_signal(result, f"{self.monitor}.offset_{self.sensor}")
+        fault = read_signal(result, f"{self.monitor}.fault_{self.sensor}") > 0.5
+        confirmed = read_signal(result, f"{self.monitor}.confirmed_{self.sensor}") > 0.5
+        events += [Event(round(float(t[k]), 9), "identified", self.sensor, "bias", float(offset[k]), self.name)
+                   for k in np.flatnonzero(confirmed & fault)]
+        order = {"detected": 0, "isolated": 1, "identified": 2, "cleared": 3}
+        return sorted(events, key=lambda e: (e.t, order[e.event]))
+
+    def design(self) -> dict:
+        return {"detector": self.name, "rule": "sensor step confirmed by g > h against every healthy model "
+                "(trend, kink, glitch); P(g > h) <= exp(-h/2) under white Gaussian noise",
+                "monitor": self.monitor, "sensor": self.sensor, "settings": self.settings}
 
 
 @dataclass(frozen=True)

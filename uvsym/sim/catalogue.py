@@ -19,6 +19,9 @@ luenberger         decay (1/s, LMI design certified in exact arithmetic) or gain
 ukf, ekf           q, r, p0 (covariances: a number, the diagonal or a full matrix)
 lms                measured, regressor, reference (signal names), order, mu, eps0, r0, window,
                    hold, confirm (samples)
+sensor_step        measured (one signal), noise_std (its white noise, default the [noise] entry of
+                   the measured output), false_alarms_per_hour, before, after, glitch (samples),
+                   alarm_z: the calibrated sensor-step monitor (:mod:`uvsym.observers.step_monitor`)
 uio_bank           poles (F's n eigenvalues), measured (outputs), decouple (disturbances): one UIO
                    per input, publishing r_<input>_<output> (:mod:`uvsym.sim.uio_block`)
 hybrid             z1, w1 (subsystem 1), sensor, sensor_gain, k1 or decay, l, gamma, m1, m2 (fault
@@ -213,6 +216,19 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
                                                                                       "input"), **options))
 
 
+def _sensor_step(fields: Fields, plant: System, dt: float, name: str) -> Block:
+    from uvsym.observers.step_monitor import sensor_step_monitor
+
+    measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
+    fields.describe("noise_std", "number", "> 0 (the measured output's unit)", "the [noise] entry of measured")
+    options = {key: fields.integer(key, default, minimum=0, unit="samples") for key, default in
+               (("before", 10), ("after", 8), ("glitch", 3))}
+    options |= {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 0.1, positive=True),
+                "alarm_z": fields.number("alarm_z", 3.5, positive=True),
+                "noise_std": fields.number("noise_std", positive=True)}
+    return observer_block(sensor_step_monitor(measured, dt=dt, name=name, **options))
+
+
 def _uio_bank(fields: Fields, plant: System, dt: float, name: str) -> Block:
     from uvsym.sim.uio_block import uio_bank_block  # here: the zonotope sets load only for a UIO bank
 
@@ -249,7 +265,7 @@ def _mmae(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
 BLOCKS = {"pid": _pid, "state_feedback": _state_feedback, "lqr": _lqr, "open_loop": _open_loop,
           "luenberger": _luenberger, "ukf": _gaussian("ukf"), "ekf": _gaussian("ekf"), "lms": _lms,
-          "uio_bank": _uio_bank, "hybrid": hybrid_block,
+          "sensor_step": _sensor_step, "uio_bank": _uio_bank, "hybrid": hybrid_block,
           "select": _select, "autopilot": _autopilot, "mmae": _mmae,
           "actuator_observer": _actuator_observer}
 

@@ -37,6 +37,9 @@ switches in the same sample) and ``[[detectors]]``:
   persists), ``ignore_before`` (s);
 - ``type = "lms"``: ``monitor`` (an lms block's name): its double criterion's decisions, and a
   StepSizeWarning when the block's mu is at or beyond the mean-square bound of the run's input power;
+- ``type = "sensor_step"``: ``monitor`` (a sensor_step block's name): its confirmed steps as
+  ``detected``, ``isolated`` and ``identified`` (the offset), ``cleared`` when the offset is back
+  to zero (:class:`~uvsym.diagnosis.detectors.StepDecision`);
 - ``type = "zonotope_bands"``: ``bank`` (a uio_bank block's name), ``noise_bound`` and
   ``initial_error`` (the stated bounds), ``generators``, ``reduction``, ``horizon``,
   ``isolation_window``, ``release``: band exits of the bank, isolation by their pattern
@@ -70,7 +73,7 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.codegen.cache import memoized
-from uvsym.diagnosis.detectors import DoubleCriterion, EstimatedFault, ResidualThreshold
+from uvsym.diagnosis.detectors import DoubleCriterion, EstimatedFault, ResidualThreshold, StepDecision
 from uvsym.errors import ScenarioError, UvsymError
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
@@ -299,6 +302,16 @@ def _setpoint_block(data: dict, path: str, plant: System) -> Block:
     return _schedule_block(Fields(data, path), plant)
 
 
+def _told_noise(fields: Fields, noise: dict[str, tuple[str, float]]) -> Fields:
+    """A sensor_step block's table with ``noise_std`` defaulting to its measured output's [noise]
+    standard deviation (Gaussian entries only; the user's table is not changed)."""
+    data = fields.data
+    if (data.get("type") != "sensor_step" or "noise_std" in data
+            or not isinstance(data.get("measured"), str) or noise.get(data["measured"], ("", 0))[0] != "noise"):
+        return fields
+    return Fields({**data, "noise_std": noise[data["measured"]][1]}, fields.path, fields.schema)
+
+
 def _schedule_block(fields: Fields, plant: System) -> Block:
     signal = fields.text("signal")
     block = schedule(fields, plant, f"setpoint_{signal}", (signal,))
@@ -333,6 +346,18 @@ def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.nd
     order = sum(n.startswith("C_") for n in block.state.names)  # the filter's weights C_1 .. C_M
     return DoubleCriterion(name, monitor, block.reads.names[0], block.description, block.parameters, regressor,
                            order)
+
+
+def _step_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
+                   step: float) -> StepDecision:
+    """``type = "sensor_step"``: the decisions of the sensor_step block named ``monitor``."""
+    monitor = fields.text("monitor")
+    blocks = {b.name: b for b in scenario_loop.blocks}
+    if monitor not in blocks or f"confirmed_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
+        steps = [b for b in blocks if any(n.startswith("confirmed_") for n in blocks[b].publishes.names)]
+        raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not a sensor_step block of the scenario"
+                            f"{_close(monitor, steps)}; sensor_step blocks: {', '.join(steps) or 'none'}")
+    return StepDecision(name, monitor, blocks[monitor].reads.names[0], blocks[monitor].description)
 
 
 def logged_input(name: str, scenario_loop: WiredLoop) -> str:
@@ -438,7 +463,8 @@ def _mmae(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w
     return mmae_detector(fields, name, scenario_loop, z0, w0, step)
 
 
-DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "zonotope_bands": _zonotope_bands,
+DETECTORS = {"threshold": _threshold_detector, "lms": _lms_detector, "sensor_step": _step_detector,
+             "zonotope_bands": _zonotope_bands,
              "hybrid": _hybrid_detector, "mmae": _mmae, "fault_diagnosis": _fault_diagnosis}
 
 
@@ -514,7 +540,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
             noise[channel] = _noise(Fields(noise_fields.data, noise_fields.path), channel)  # no per-plant rows
             noise_fields.used.add(channel)
     blocks = [_setpoint(f, plant) for f in top.tables("setpoints")]
-    blocks += [build_block(f, plant, step) for f in top.tables("blocks")]
+    blocks += [build_block(_told_noise(f, noise), plant, step) for f in top.tables("blocks")]
     actuator_faults, sensor_faults = _faults(top.tables("faults"), plant, duration, noise)
     by, when = _substitutions(top.table("substitutions"))
     detector_tables = top.tables("detectors")
