@@ -32,22 +32,26 @@ def biased_plant():
 
 
 def numpy_bank(Y, U, p_min, prior, reset):
-    """Two Kalman filters (3 and 4 states), Bayes in log space with the floor, fusion of a, b, c, reset."""
+    """Two Kalman filters (3 and 4 states), Bayes in log space with the floor, fusion of a, b, c, reset;
+    also each filter's NIS r^T S^-1 r and the bias's posterior standard deviation."""
     models = [(A, B, C, Q, X0.copy(), P0.copy()), (A4, B4, C4, Q4, X04.copy(), P04.copy())]
     states = [[m[4], m[5]] for m in models]
     logp = np.log(np.asarray(prior) / np.sum(prior))
-    probabilities, fused_all = [], []
+    probabilities, fused_all, nis_all, std_all = [], [], [], []
     for y, u in zip(Y, U):
-        posts, logliks = [], []
+        posts, logliks, nis = [], [], []
         for (_, _, Cm, _, _, _), (x, P) in zip(models, states):
             S = Cm @ P @ Cm.T + R
             K = P @ Cm.T @ np.linalg.inv(S)
             logliks.append(multivariate_normal(Cm @ x, S).logpdf(y))
+            nis.append((y - Cm @ x) @ np.linalg.solve(S, y - Cm @ x))
             posts.append([x + K @ (y - Cm @ x), P - K @ S @ K.T])
         logp = logp + np.array(logliks)
         logp = np.maximum(logp - logsumexp(logp), np.log(p_min))
         logp = logp - logsumexp(logp)
         p = np.exp(logp)
+        nis_all.append(nis)
+        std_all.append(np.sqrt(posts[1][1][3, 3]))
         fused = p[0] * posts[0][0] + p[1] * posts[1][0][:3]
         if reset:
             posts[0][0] = fused.copy()
@@ -55,7 +59,7 @@ def numpy_bank(Y, U, p_min, prior, reset):
         states = [[Am @ x + Bm @ u, Am @ P @ Am.T + Qm] for (Am, Bm, _, Qm, _, _), (x, P) in zip(models, posts)]
         probabilities.append(p)
         fused_all.append(fused)
-    return np.array(probabilities), np.array(fused_all)
+    return np.array(probabilities), np.array(fused_all), np.array(nis_all), np.array(std_all)
 
 
 @pytest.mark.parametrize("make", [unscented_filter, extended_filter])
@@ -73,10 +77,13 @@ def test_bank_equals_a_numpy_bank_of_kalman_filters(make, reset):
                "biased": make(biased_plant(), dt=0.1, Q=Q4, R=R, P0=P04, x0=X04, name="biased")}
     bank = mmae_bank(filters, p_min=1e-3, prior=(0.9, 0.1), reset=reset)
     _, OUT = run_filter(bank, Y, U)
-    p_expected, fused_expected = numpy_bank(Y, U, 1e-3, (0.9, 0.1), reset)
+    p_expected, fused_expected, nis_expected, std_expected = numpy_bank(Y, U, 1e-3, (0.9, 0.1), reset)
     names = bank.publishes.names
     np.testing.assert_allclose(OUT[:, [names.index("p_plain"), names.index("p_biased")]], p_expected, atol=1e-9)
     np.testing.assert_allclose(OUT[:, [names.index(f"{s}_hat") for s in "abc"]], fused_expected, atol=1e-9)
+    np.testing.assert_allclose(OUT[:, [names.index("nis_plain"), names.index("nis_biased")]], nis_expected,
+                               rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(OUT[:, names.index("biased.bias_std")], std_expected, rtol=1e-7)
     assert "biased.bias_hat" in names and p_expected[150:, 1].min() > 0.95  # the data do discriminate
     assert p_expected.min() >= 1e-3 * 0.99  # the floor holds (up to the renormalisation)
 

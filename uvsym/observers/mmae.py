@@ -4,8 +4,10 @@ log space, federated fusion and reset, as one :class:`~uvsym.observers.base.Obse
 Each model i is a :class:`~uvsym.observers.kalman.GaussianFilter` (UKF or EKF, of any state
 size) reading the same measurements and inputs. At sample k every filter makes its measurement
 update and its log-likelihood ``l_i = log f(y_k | theta_i, Y_{k-1})`` (the fault paper's eqs.
-25-28, with the UKF's own ``P_zz`` as the innovation covariance of eq. 28). Bayes' rule in log
-space, with a floor::
+25-28, with the UKF's own ``P_zz`` as the innovation covariance of eq. 28), and its normalised
+innovation squared ``nis_i = r_i^T S_i^-1 r_i = 2 (l_i(yhat_i) - l_i(y_k))`` (the likelihood at the
+predicted measurement less the one at y_k: chi-square with n_y degrees of freedom while model i
+is right). Bayes' rule in log space, with a floor::
 
     log p_i <- l_i + log p_i - logsumexp_j(l_j + log p_j)
     log p_i <- max(log p_i, log p_min), renormalised (logsumexp)
@@ -18,8 +20,9 @@ model starts each sample from the best estimate and wins back. A NaN measurement
 update and leaves the probabilities unchanged (``skipped`` = 1).
 
 State: each filter's ``[xhat; tril(P)]`` prefixed ``<model>.``, then ``logp.<model>``. Publishes
-the fused ``<x>_hat``, ``p_<model>``, each model's own states (e.g. ``left.alpha_T_L_hat``),
-``loglik_<model>``, ``pd_margin`` (smallest over the bank) and ``skipped``.
+the fused ``<x>_hat``, ``p_<model>``, each model's own states (e.g. ``left.alpha_T_L_hat``) and
+their posterior standard deviations (``left.alpha_T_L_std``), ``loglik_<model>``, ``nis_<model>``
+(0 where the update was skipped), ``pd_margin`` (smallest over the bank) and ``skipped``.
 """
 
 from __future__ import annotations
@@ -100,12 +103,14 @@ def mmae_bank(filters: dict[str, GaussianFilter], *, name: str = "mmae", p_min: 
     floor = float(np.log(p_min))
 
     def step(s, y, u, p):
-        posts, logliks, margins, skipped = [], [], [], 0.0
+        posts, logliks, nis, margins, skipped = [], [], [], [], 0.0
         for m, n, start in zip(models, sizes, slots):
             x, P = s[start:start + n], unpacked(s[start + n:start + n + n * (n + 1) // 2], n)
-            x_post, P_post, _, loglik, margin, skipped = measurement_gate(filters[m], x, P, y, u, p)
+            x_post, P_post, r, loglik, margin, skipped = measurement_gate(filters[m], x, P, y, u, p)
+            at_prediction = measurement_gate(filters[m], x, P, y - r, u, p)[3]  # y - r: the predicted y
             posts.append((x_post, P_post))
             logliks.append(loglik)
+            nis.append(2.0 * (at_prediction - loglik))
             margins.append(margin)
         logp = log_normalised(ca.fmax(log_normalised(s[slots[-1]:] + ca.vertcat(*logliks)), floor))
         probability = ca.exp(logp)
@@ -120,24 +125,28 @@ def mmae_bank(filters: dict[str, GaussianFilter], *, name: str = "mmae", p_min: 
             x_next, P_next, margin = filters[m].predict(x_post, P_post, u, p)
             margins.append(margin)
             s_next += [x_next, packed(P_next)]
-            own += [posts[i][0][j] for j, n in enumerate(filters[m].system.x.names) if n not in shared]
+            mine = [j for j, n in enumerate(filters[m].system.x.names) if n not in shared]
+            own += [posts[i][0][j] for j in mine] + [ca.sqrt(ca.fmax(P_post[j, j], 0.0)) for j in mine]
         margin = margins[0]
         for v in margins[1:]:
             margin = ca.fmin(margin, v)
-        out = ca.vertcat(fused, probability, *own, *logliks, margin, skipped)
+        out = ca.vertcat(fused, probability, *own, *logliks, *nis, margin, skipped)
         return tuple(ca.cse([ca.vertcat(*s_next, logp), out]))  # shared subexpressions once
 
     state, own = Signals(group="state"), Signals(group="estimate")
     for m in models:
         x = filters[m].system.x
         state = state + (x.renamed(suffix="_hat") + covariance_signals(x)).renamed(prefix=f"{m}.")
-        own = own + x.select([n for n in x.names if n not in shared]).renamed(prefix=f"{m}.", suffix="_hat")
+        mine = x.select([n for n in x.names if n not in shared])
+        own = own + mine.renamed(prefix=f"{m}.", suffix="_hat") + mine.renamed(prefix=f"{m}.", suffix="_std")
     state = state + Signals(tuple(f"logp.{m}" for m in models), ("-",) * count,
                             tuple(f"log probability of model {m}" for m in models), "state")
     publishes = (first.x.select(shared).renamed(suffix="_hat", group="estimate")
                  + Signals(tuple(f"p_{m}" for m in models), ("-",) * count,
                            tuple(f"probability of model {m}" for m in models), "probability")
                  + own + Signals(tuple(f"loglik_{m}" for m in models), ("-",) * count, (), "diagnostic")
+                 + Signals(tuple(f"nis_{m}" for m in models), ("-",) * count,
+                           tuple(f"normalised innovation squared of model {m}" for m in models), "diagnostic")
                  + Signals(("pd_margin", "skipped"), ("-", "-"),
                            ("smallest relative Cholesky pivot of the bank's step (> 0: P.D.)",
                             "1 where y_k had a NaN and the updates were skipped"), "diagnostic"))

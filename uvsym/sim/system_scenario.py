@@ -53,7 +53,10 @@ switches in the same sample) and ``[[detectors]]``:
   ``dwell`` (samples, default 1), ``settle`` (samples, default 20) and ``resolution`` (default
   0.02: an efficiency estimate is published where it stays within it over settle samples),
   ``ignore_before`` (s), ``kind`` (default proportional): the
-  bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`).
+  bank's hypothesis switches (:mod:`uvsym.diagnosis.hypotheses`); ``rule = "evidence"`` instead
+  (the default ``"posterior"`` is the paper's): CUSUM detection, windowed release and an NIS test
+  (``unexplained``) with thresholds from ``false_alarms_per_hour`` (default 1), ``clear_window``
+  and ``nis_window`` (samples, default 60 and 20).
 - ``type = "fault_diagnosis"``: ``observer`` (an actuator_observer block of kind bias, on a
   vehicle plant) and the fields of a vehicle scenario's [diagnosis] table but ``correct``: the
   continuous actuator diagnosis on the finished record (:mod:`uvsym.diagnosis.wired`).
