@@ -55,6 +55,8 @@ def _target_section(manifest: dict) -> str:
     libraries = ", ".join(f"`{s}`" for s in figures["library_symbols"]) or "none"
     check = figures["cppcheck"]
     cppcheck = ("cppcheck was not installed when this package was built." if check is None else
+                f"{check['version']} (default checks) stopped after {check['timed_out_s']} s: not analysed."
+                if check.get("timed_out_s") else
                 f"{check['version']} (default checks): {len(check['findings'])} findings"
                 + "".join(f"\n- {line}" for line in check["findings"][:20]))
     return f"""

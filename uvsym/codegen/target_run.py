@@ -15,7 +15,7 @@ that target (:mod:`uvsym.codegen.targets`) with ``-Wall -Wextra -Werror``, then 
   call and calibrates ticks per instruction on a loop of known length (bare metal only);
 - the C library symbols the package objects need (``nm -u``), refused when one allocates or
   does I/O (``FORBIDDEN``), and the findings of ``cppcheck`` (default checks, one preprocessor
-  configuration; its information messages left out) when installed;
+  configuration; its information messages left out; stopped after ``CPPCHECK_SECONDS``) when installed;
 - each call's outputs, decoded from their bits, with their return codes, and how far they are
   from CasADi's evaluation of the same vectors (:func:`differences`): a double build in units
   of the last place (2^-52) of each output's scale ``max(1, max|Python|)``, a float build relative
@@ -44,6 +44,7 @@ __all__ = ["BUDGET_KEYS", "FORBIDDEN", "BudgetError", "TargetRun", "check_budget
 FORBIDDEN = ("malloc", "calloc", "realloc", "free", "_sbrk", "sbrk", "printf", "fprintf", "sprintf", "snprintf",
              "vprintf", "puts", "fputs", "putchar", "fopen", "fwrite", "fread", "write", "_write", "scanf")
 BUDGET_KEYS = ("flash", "ram", "stack", "instructions")
+CPPCHECK_SECONDS = 60  # cppcheck's time limit per package (its result then says it timed out)
 
 
 class BudgetError(CodegenError):
@@ -139,13 +140,16 @@ def _cppcheck(package_dir: Path, name: str) -> dict | None:
     """cppcheck's default checks on the package sources: its version and findings (None: not installed)."""
     if shutil.which("cppcheck") is None:
         return None
-    done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1",
-                           "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
-                           f"src/{name}_casadi.c", f"src/{name}.c"], cwd=package_dir,
-                          capture_output=True, text=True, timeout=600)
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
+    try:
+        done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1",
+                               "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
+                               f"src/{name}_casadi.c", f"src/{name}.c"], cwd=package_dir,
+                              capture_output=True, text=True, timeout=CPPCHECK_SECONDS)
+    except subprocess.TimeoutExpired:  # its value-flow analysis of a large generated source can take many minutes
+        return {"version": version, "findings": [], "timed_out_s": CPPCHECK_SECONDS}
     findings = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: (?!information)\w+: ", line)]
-    return {"version": version, "findings": findings}
+    return {"version": version, "findings": findings, "timed_out_s": None}
 
 
 def _decode(hexes: list[str], precision: str) -> np.ndarray:
