@@ -21,10 +21,11 @@ from uvsym.progress import ProgressBar
 __all__ = ["CAMPAIGN", "DETECTORS", "campaign_results"]
 
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
-DETECTORS = ("double_criterion", "error_threshold")  # the detectors of the scenario files, in their order
+DETECTORS = ("double_criterion", "error_threshold", "step_test")  # the detectors of the scenario files, in their order
 FIGURES = ("runs", "fault_runs", "detection_probability", "missed_detections", "median_detection_delay_s",
            "correct_isolation", "false_alarms", "healthy_hours", "false_alarms_per_hour")
-BIAS_CASE, HEALTHY_CASE = "bias step", "no fault"
+BIAS_CASE, HEALTHY_CASE, PULSE_CASE = "bias step", "no fault", "pulse"
+STEP_S = 0.2  # s: the scenario's sample period
 NOMINAL_NOISE = 0.008726646259971648  # rad: the scenario's compass noise (0.5 deg), where a row leaves it unset
 TABLE_COLUMNS = ("case", "true_kind", "true_value", "onset_s", "end_s", "seed", "noise.psi", "faults[0].duration",
                  "faults[0].rate", "faults[0].period", "setpoints[0].values") + tuple(
@@ -59,6 +60,18 @@ def _by_size(rows: list[dict]) -> list[dict]:
             for (size, noise), members in sorted(groups.items())]
 
 
+def _pulses(rows: list[dict]) -> list[dict]:
+    """Pulses of the bias (glitches and longer): per length (samples), runs and detections per detector."""
+    groups: dict[int, list[dict]] = {}
+    for row in rows:
+        if row["case"] == PULSE_CASE and row["status"] == "ok":
+            samples = math.ceil((row["end_s"] - row["onset_s"]) / STEP_S - 1e-9)  # the samples the bias is on
+            groups.setdefault(samples, []).append(row)
+    return [{"samples": length, "runs": len(members),
+             **{d: sum(bool(r[f"{d}:detected"]) for r in members) for d in DETECTORS}}
+            for length, members in sorted(groups.items())]
+
+
 def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dict:
     """Run the campaign; write campaign_results.csv into out_dir; return its figures (module docstring)."""
     campaign = load_campaign(CAMPAIGN)
@@ -74,7 +87,7 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     return {"runs": len(rows), "errors": errors,
             "simulated_hours": sum(r["duration_s"] or 0.0 for r in rows) / 3600.0,
             "detectors": _figures(rows), "cases": {case: _figures(members) for case, members in cases.items()},
-            "bias_by_size": _by_size(rows), "healthy_by_noise": _healthy_by_noise(rows)}
+            "bias_by_size": _by_size(rows), "healthy_by_noise": _healthy_by_noise(rows), "pulses": _pulses(rows)}
 
 
 def _write_table(rows: list[dict], path: Path) -> None:

@@ -41,7 +41,7 @@ from uvsym.systems.system import System
 
 __all__ = ["Design", "design", "DT", "ORDER", "MU", "SET_POINT_DEG", "EPS0_DEG2", "R0", "WINDOW", "HOLD", "CONFIRM",
            "BANDWIDTH", "COMPASS_NOISE_DEG",
-           "DECISIONS", "STEP_MONITOR", "STEP_FALSE_ALARMS_PER_HOUR",
+           "DECISIONS", "STEP_MONITOR", "STEP_FALSE_ALARMS_PER_HOUR", "STEP_WINDOW",
            "TORQUE_NOISE", "WARM_UP", "RECORD", "FAULT_SAMPLE", "FAULT_SIZES_DEG"]
 
 # the paper's numbers
@@ -66,6 +66,7 @@ RECORD = 400  # samples recorded (80 s): the fault at 70 leaves 66 s after it
 DECISIONS = ("paper", "calibrated")  # the double criterion, or the calibrated sensor-step monitor
 STEP_MONITOR = "step"  # the step monitor's block name
 STEP_FALSE_ALARMS_PER_HOUR = 0.1  # designed bound on its false confirmations (the scenario files' too)
+STEP_WINDOW = (10, 8, 3)  # its samples before and after a candidate step, and the longest glitch released
 
 
 @dataclass(frozen=True)
@@ -144,7 +145,8 @@ def step_monitor(plant: System, noise_deg: float = COMPASS_NOISE_DEG) -> Observe
     """The calibrated sensor-step monitor of the compass (:mod:`uvsym.observers.step_monitor`), told its
     noise (deg), with confirmations designed for ``STEP_FALSE_ALARMS_PER_HOUR``."""
     return sensor_step_monitor(plant.y, noise_std=math.radians(noise_deg), dt=DT,
-                               false_alarms_per_hour=STEP_FALSE_ALARMS_PER_HOUR, name=STEP_MONITOR)
+                               false_alarms_per_hour=STEP_FALSE_ALARMS_PER_HOUR, before=STEP_WINDOW[0],
+                               after=STEP_WINDOW[1], glitch=STEP_WINDOW[2], name=STEP_MONITOR)
 
 
 def torque_table(samples: int, seed: int, sigma: float = TORQUE_NOISE) -> np.ndarray:

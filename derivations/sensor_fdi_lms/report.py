@@ -18,6 +18,7 @@ from derivations.sensor_fdi_lms.study import R0_GRID, SIZE_DEG, WITHIN, detectio
 from derivations.sensor_fdi_lms.text import report_text
 from uvsym.errors import SimulationError
 from uvsym.observers.lms import lms_step, mu_bound
+from uvsym.observers.step_monitor import step_models, step_threshold
 from uvsym.report import write_json
 from uvsym.report.equations import function_equations
 from uvsym.report.sections import c_package, claim_rows
@@ -102,6 +103,20 @@ def _ftc_over_seeds(size: float, mode: str) -> dict:
             "confirmed": sum(s["confirmed_sample"] is not None for s in summaries)}
 
 
+def _calibrated(progress) -> dict:
+    """The calibrated sensor-step monitor switching the substitute: the FTC error per fault size and
+    seed of FTC_SEEDS, and its designed threshold."""
+    errors = {}
+    for size in D.FAULT_SIZES_DEG + (-30.0,):
+        progress(f"calibrated monitor, FTC over {len(FTC_SEEDS)} noise seeds: {size:+g} deg")
+        errors[f"{size:g}"] = [_max_error(Run(size_deg=size, decision="calibrated", seed=seed)) for seed in FTC_SEEDS]
+    return {"max_abs_heading_error_deg": errors, "false_alarms_per_hour": D.STEP_FALSE_ALARMS_PER_HOUR,
+            "per_test_probability": D.STEP_FALSE_ALARMS_PER_HOUR * D.DT / 3600.0,
+            "threshold": step_threshold(D.STEP_FALSE_ALARMS_PER_HOUR, D.DT),
+            "smallest_step_deg": math.sqrt(step_threshold(D.STEP_FALSE_ALARMS_PER_HOUR, D.DT))
+            * float(step_models(*D.STEP_WINDOW)["step_std"][-1]) * D.COMPASS_NOISE_DEG}
+
+
 def _robustness(progress) -> dict:
     """The FTC error over noise seeds (both substitution rules) and over heading laws (+30 deg, seed 0)."""
     seeds = {}
@@ -184,7 +199,7 @@ def build(out_dir: Path, progress) -> None:
         "transient": {size: _transient(outcomes[(float(size), "ftc")]) for size in ftc},
         "plant": {"yaw_time_constant_s": D.yaw_model(D.design().plant)[0],
                   "full_thrust_turn_deg_s": math.degrees(D.turn_rate(D.design().plant, 1.0))},
-        "runs": summaries, "robustness": robustness, "steps": steps,
+        "runs": summaries, "robustness": robustness, "steps": steps, "calibrated": _calibrated(progress),
         "learning": _learning(healthy_input(), outcomes[(30.0, "ftc")]),
         "study": {"seeds": study.seeds, "size_deg": SIZE_DEG, "within_samples": WITHIN, "roc": study.roc,
                   "nominal": study.delays, "r0_grid": list(R0_GRID)},
