@@ -434,7 +434,7 @@ def test_convergence_claims_take_the_corners_of_the_desired_actions():
     assert_proved(bias)
     assert bias.set == "K = [3.0, 0.333333]"
     # A = -diag(K) is one matrix whatever tau_d: one vertex, not the corners of a tau_d box that plays no part
-    assert bias.method == "LMI (cvxpy, Clarabel) at 1 vertices, re-checked by exact rational LDL^T"
+    assert bias.method == "LMI (cvxpy, Clarabel) at 1 vertex, re-checked by exact rational LDL^T"
     P, A = np.array(bias.details["P"]), -np.diag([3.0, 1.0 / 3.0])
     assert np.linalg.eigvalsh(P).min() > 0 and np.linalg.eigvalsh(A.T @ P + P @ A + 0.5 * P).max() < 0
     assert_refuted(convergence_claim("Toy", _toy_observer("bias"), [3.0, 1.0 / 3.0], 5.0, 9.0, 0.5, expected="refuted"))
