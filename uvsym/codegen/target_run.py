@@ -26,6 +26,7 @@ that target (:mod:`uvsym.codegen.targets`) with ``-Wall -Wextra -Werror``, then 
 
 from __future__ import annotations
 
+import hashlib
 import re
 import shutil
 import struct
@@ -136,15 +137,26 @@ def _stack_bound(function: str, frames, edges) -> tuple[int | None, str, list[st
         return None, str(why), sorted(external)
 
 
+_CPPCHECKED: dict[bytes, dict] = {}  # sources' digest -> result: one analysis per source, whatever the target
+
+
 def _cppcheck(package_dir: Path, name: str) -> dict | None:
     """cppcheck's default checks on the package sources: its version and findings (None: not installed)."""
     if shutil.which("cppcheck") is None:
         return None
+    sources = [f"src/{name}_casadi.c", f"src/{name}.c"]
+    digest = hashlib.sha256(b"".join((package_dir / s).read_bytes() for s in sources)).digest()
+    if digest not in _CPPCHECKED:
+        _CPPCHECKED[digest] = _run_cppcheck(package_dir, sources)
+    return dict(_CPPCHECKED[digest])
+
+
+def _run_cppcheck(package_dir: Path, sources: list[str]) -> dict:
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
     try:
         done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1",
                                "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
-                               f"src/{name}_casadi.c", f"src/{name}.c"], cwd=package_dir,
+                               *sources], cwd=package_dir,
                               capture_output=True, text=True, timeout=CPPCHECK_SECONDS)
     except subprocess.TimeoutExpired:  # its value-flow analysis of a large generated source can take many minutes
         return {"version": version, "findings": [], "timed_out_s": CPPCHECK_SECONDS}
