@@ -83,9 +83,9 @@ def test_quick_look_of_a_wired_loop_shows_states_inputs_and_blocks(tmp_path):
     controller = pid("c", measured="m", reference=1.0, kp=2.0, ki=1.0, output="F", dt=DT)
     result = simulate_system(first_order(), [controller], duration=1.0, dt=DT, x0=[0.0])
     figure = result.plot(tmp_path / "loop.svg")
-    titles = [ax.get_title(loc="left") for ax in figure.axes]
-    assert titles == ["x (m/s)", "u (N)"]  # the command is the plant input: drawn once
+    labels = [ax.get_ylabel() for ax in figure.axes]
+    assert labels == ["x (m/s)", "u (N)"]  # the command is the plant input: drawn once
     assert (tmp_path / "loop.svg").read_text().startswith("<?xml")
     faulty = simulate_system(first_order(), [controller], duration=1.0, dt=DT, x0=[0.0],
                              actuator_faults=(ActuatorFault(0, "bias", 0.5, Profile(onset=0.5)),))
-    assert [ax.get_title(loc="left") for ax in faulty.plot().axes] == ["x (m/s)", "u (N)", "c (N)"]
+    assert [ax.get_ylabel() for ax in faulty.plot().axes] == ["x (m/s)", "u (N)", "c (N)"]

@@ -107,6 +107,7 @@ def test_the_package_is_written_again_over_its_own_make_products_but_not_over_a_
     from uvsym.codegen.build_files import make_products
 
     for product in make_products("rov_yaw_compass_bias"):      # as `make` leaves them
+        (out / product).parent.mkdir(parents=True, exist_ok=True)
         (out / product).write_bytes(b"built")
     assert main(["codegen", "rov_yaw_compass_bias", "-o", str(out)]) == 0
     (out / "notes.txt").write_text("mine")

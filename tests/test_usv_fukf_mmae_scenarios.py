@@ -244,7 +244,7 @@ def test_the_campaign_covers_both_thrusters_profiles_noise_levels_and_healthy_ho
     assert noise == {0.05, 0.1, 0.15}
     healthy = sum(r.scenario["duration"] for r in runs if not r.scenario["faults"] and r.scenario["noise"]["x"] == 0.05)
     assert healthy >= 1440.0  # s of healthy runs at the paper's noise (24 min; onsets add more)
-    assert all(len(r.scenario["detectors"]) == 4 for r in runs)
+    assert all(len(r.scenario["detectors"]) == 5 for r in runs)
 
 
 def test_the_autopilot_clamps_its_commands_to_the_limits_it_is_given():
