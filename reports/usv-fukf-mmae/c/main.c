@@ -10,7 +10,7 @@ int main(void) {
   static const uvsym_otter_ukf_mmae_real u[2] = {0};
   static const uvsym_otter_ukf_mmae_real p[2] = {0};
   uvsym_otter_ukf_mmae_real s_next[100];
-  uvsym_otter_ukf_mmae_real out[16];
+  uvsym_otter_ukf_mmae_real out[21];
   rc = uvsym_otter_ukf_mmae_ukf_step(s, y, u, p, s_next, out);
   if (rc != UVSYM_OTTER_UKF_MMAE_OK) {
     fprintf(stderr, "uvsym_otter_ukf_mmae_ukf_step returned %d\n", rc);
@@ -20,7 +20,7 @@ int main(void) {
   for (i = 0; i < 100; ++i) printf(" %.17g", (double)s_next[i]);
   printf("\n");
   printf("out");
-  for (i = 0; i < 16; ++i) printf(" %.17g", (double)out[i]);
+  for (i = 0; i < 21; ++i) printf(" %.17g", (double)out[i]);
   printf("\n");
   return 0;
 }

@@ -230,7 +230,7 @@ typedef double uvsym_otter_ukf_mmae_real;
  *       [97] logp.nofault [-]
  *       [98] logp.left [-]
  *       [99] logp.right [-]
- * out out[16]: published
+ * out out[21]: published
  *       [0] x_hat [m]
  *       [1] y_hat [m]
  *       [2] psi_hat [rad]
@@ -241,14 +241,19 @@ typedef double uvsym_otter_ukf_mmae_real;
  *       [7] p_left [-]
  *       [8] p_right [-]
  *       [9] left.alpha_T_L_hat [-]
- *       [10] right.alpha_T_R_hat [-]
- *       [11] loglik_nofault [-]
- *       [12] loglik_left [-]
- *       [13] loglik_right [-]
- *       [14] pd_margin [-]
- *       [15] skipped [-]
+ *       [10] left.alpha_T_L_std [-]
+ *       [11] right.alpha_T_R_hat [-]
+ *       [12] right.alpha_T_R_std [-]
+ *       [13] loglik_nofault [-]
+ *       [14] loglik_left [-]
+ *       [15] loglik_right [-]
+ *       [16] nis_nofault [-]
+ *       [17] nis_left [-]
+ *       [18] nis_right [-]
+ *       [19] pd_margin [-]
+ *       [20] skipped [-]
  * Returns UVSYM_OTTER_UKF_MMAE_OK, UVSYM_OTTER_UKF_MMAE_EVAL_FAILED, UVSYM_OTTER_UKF_MMAE_NONFINITE_INPUT, UVSYM_OTTER_UKF_MMAE_NONFINITE_OUTPUT or UVSYM_OTTER_UKF_MMAE_UNHEALTHY.
  * Uses static work buffers: not reentrant. */
-int uvsym_otter_ukf_mmae_ukf_step(const uvsym_otter_ukf_mmae_real s[100], const uvsym_otter_ukf_mmae_real y[6], const uvsym_otter_ukf_mmae_real u[2], const uvsym_otter_ukf_mmae_real p[2], uvsym_otter_ukf_mmae_real s_next[100], uvsym_otter_ukf_mmae_real out[16]);
+int uvsym_otter_ukf_mmae_ukf_step(const uvsym_otter_ukf_mmae_real s[100], const uvsym_otter_ukf_mmae_real y[6], const uvsym_otter_ukf_mmae_real u[2], const uvsym_otter_ukf_mmae_real p[2], uvsym_otter_ukf_mmae_real s_next[100], uvsym_otter_ukf_mmae_real out[21]);
 
 #endif /* UVSYM_OTTER_UKF_MMAE_H */
