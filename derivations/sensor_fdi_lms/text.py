@@ -221,7 +221,7 @@ Long healthy runs at a constant set-point ({healthy['double_criterion']['runs']}
 1.5 deg compass noise): the double criterion raises {healthy['double_criterion']['false_alarms']} false alarms
 ({_shown(healthy['double_criterion']['false_alarms_per_hour'])} per hour), the error threshold
 {healthy['error_threshold']['false_alarms']} ({_shown(healthy['error_threshold']['false_alarms_per_hour'])} per
-hour). Heading set-point changes (150 deg to 155, 170, 210 or 140 deg, no fault): the double criterion
+hour). Heading set-point changes (150 deg to 140, 153.5, 155, 170, 210, 320 or 30 deg, no fault): the double criterion
 raises {setpoints['double_criterion']['false_alarms']} false alarms in {setpoints['double_criterion']['runs']} runs,
 the error threshold {setpoints['error_threshold']['false_alarms']}. The long healthy runs by compass noise (the design's
 0.5 deg, and 2 and 3 times it):
