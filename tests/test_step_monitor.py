@@ -143,3 +143,13 @@ def test_the_noise_the_monitor_is_told_is_the_scenarios():
     table["blocks"][1]["glitch"] = 9
     with pytest.raises(ScenarioError, match="glitch"):
         parse_system_scenario(table, root=DERIVATION.scenarios["compass_calibrated"].parent)
+
+
+@pytest.mark.parametrize("detector, monitor, message", [("sensor_step", "lms", "not a sensor_step block"),
+                                                         ("lms", "step", "not an lms block"),
+                                                         ("sensor_step", "stepp", "'step'")])
+def test_a_detector_on_the_wrong_monitor_is_refused_naming_it(detector, monitor, message):
+    table = _scenario()
+    table["detectors"] = [{"type": detector, "name": "d", "monitor": monitor}]
+    with pytest.raises(ScenarioError, match=message):
+        parse_system_scenario(table, root=DERIVATION.scenarios["compass_calibrated"].parent)

@@ -336,15 +336,21 @@ def _substitutions(fields: Fields | None) -> tuple[dict[str, str], dict[str, str
     return by, when
 
 
+def _check_monitor(fields: Fields, monitor: str, blocks: dict, flag: str, what: str, listed: str) -> None:
+    """ScenarioError naming ``monitor`` unless it is a block publishing ``<flag><its measured signal>``."""
+    if monitor in blocks and f"{flag}{blocks[monitor].reads.names[0]}" in blocks[monitor].publishes.names:
+        return
+    known = [b for b in blocks if any(n.startswith(flag) for n in blocks[b].publishes.names)]
+    raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not {what} of the scenario{_close(monitor, known)}; "
+                        f"{listed}: {', '.join(known) or 'none'}")
+
+
 def _lms_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.ndarray,
                   step: float) -> DoubleCriterion:
     """``type = "lms"``: the double criterion of the lms block named ``monitor``."""
     monitor = fields.text("monitor")
     blocks = {b.name: b for b in scenario_loop.blocks}
-    if monitor not in blocks or f"fault_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
-        lms_blocks = [b for b in blocks if any(n.startswith("fault_") for n in blocks[b].publishes.names)]
-        raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not an lms block of the scenario"
-                            f"{_close(monitor, lms_blocks)}; lms blocks: {', '.join(lms_blocks) or 'none'}")
+    _check_monitor(fields, monitor, blocks, "R_", "an lms block", "lms blocks")
     block, regressor = blocks[monitor], logged_input(blocks[monitor].reads.names[1], scenario_loop)
     order = sum(n.startswith("C_") for n in block.state.names)  # the filter's weights C_1 .. C_M
     return DoubleCriterion(name, monitor, block.reads.names[0], block.description, block.parameters, regressor,
@@ -356,10 +362,7 @@ def _step_detector(fields: Fields, name: str, scenario_loop: WiredLoop, z0: np.n
     """``type = "sensor_step"``: the decisions of the sensor_step block named ``monitor``."""
     monitor = fields.text("monitor")
     blocks = {b.name: b for b in scenario_loop.blocks}
-    if monitor not in blocks or f"confirmed_{blocks[monitor].reads.names[0]}" not in blocks[monitor].publishes.names:
-        steps = [b for b in blocks if any(n.startswith("confirmed_") for n in blocks[b].publishes.names)]
-        raise ScenarioError(f"{fields.path}.monitor: {monitor!r} is not a sensor_step block of the scenario"
-                            f"{_close(monitor, steps)}; sensor_step blocks: {', '.join(steps) or 'none'}")
+    _check_monitor(fields, monitor, blocks, "confirmed_", "a sensor_step block", "sensor_step blocks")
     return StepDecision(name, monitor, blocks[monitor].reads.names[0], blocks[monitor].description)
 
 
