@@ -143,6 +143,9 @@ def test_the_noise_the_monitor_is_told_is_the_scenarios():
     table["blocks"][1]["glitch"] = 9
     with pytest.raises(ScenarioError, match="glitch"):
         parse_system_scenario(table, root=DERIVATION.scenarios["compass_calibrated"].parent)
+    table["blocks"][1] |= {"glitch": 3, "measured": "psii"}
+    with pytest.raises(ScenarioError, match="noise_std: not given, and \\[noise\\] has no Gaussian entry for 'psii'"):
+        parse_system_scenario(table, root=DERIVATION.scenarios["compass_calibrated"].parent)
 
 
 @pytest.mark.parametrize("detector, monitor, message", [("sensor_step", "lms", "not a sensor_step block"),

@@ -221,6 +221,9 @@ def _sensor_step(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
     measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
     fields.describe("noise_std", "number", "> 0 (the measured output's unit)", "the [noise] entry of measured")
+    if fields.schema is None and not fields.has("noise_std"):
+        raise ScenarioError(f"{fields._name('noise_std')}: not given, and [noise] has no Gaussian entry for "
+                            f"{measured.names[0]!r} (the plant's outputs: {', '.join(plant.y.names)}) to default to")
     options = {key: fields.integer(key, default, minimum=0, unit="samples") for key, default in
                (("before", 10), ("after", 8), ("glitch", 3))}
     options |= {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 0.1, positive=True),
