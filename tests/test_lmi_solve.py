@@ -14,8 +14,10 @@ import uvsym.verify.lmi as lmi
 from uvsym.errors import VerificationError
 from uvsym.verify.lmi import BlockLMI, _exact_check, _solve, block_lmi, block_lmi_claim, solve_block_lmi
 
-METHOD = ("block LMI (2 blocks, cvxpy + Clarabel), re-checked by exact rational LDL^T; "
-          "infeasibility by an exact dual certificate")
+PROVED = ("block LMI (2 blocks) solved by cvxpy + Clarabel; its P and K re-checked by exact rational LDL^T "
+          "(margin: the smallest pivot)")
+REFUTED = ("block LMI (2 blocks) infeasible: a dual certificate Z (modes that no gain moves (PBH)) with Z >= 0, "
+           "C_i Z_ii = 0, [Omega Z + Z Omega^T + 2 alpha Z]_ii >= 0 in exact rationals")
 
 
 def _decays(problem, P, K, rate):
@@ -152,7 +154,7 @@ def test_a_proved_certificate_says_what_where_how_and_carries_the_gains(monkeypa
     _clock(monkeypatch)
     gains, certificate = solve_block_lmi(problem, expected="refuted")
     assert (certificate.claim, certificate.set, certificate.method) == ("block LMI", "blocks a, b; decay 0.5 1/s",
-                                                                        METHOD)
+                                                                        PROVED)
     assert (certificate.status, certificate.expected) == ("proved", "refuted")
     assert certificate.seconds == 2.5
     assert gains.certificate is certificate
@@ -168,7 +170,7 @@ def test_a_refuted_certificate_says_what_where_how(monkeypatch):
     gains, certificate = solve_block_lmi(problem, "unseen mode", "a and b", expected="refuted")
     assert gains is None and certificate.status == "refuted"
     assert certificate.counterexample["Z"] == [["1", "0"], ["0", "0"]]
-    assert (certificate.claim, certificate.set, certificate.method) == ("unseen mode", "a and b", METHOD)
+    assert (certificate.claim, certificate.set, certificate.method) == ("unseen mode", "a and b", REFUTED)
     assert certificate.seconds == 2.5
 
 
@@ -179,6 +181,8 @@ def test_an_inconclusive_certificate_says_what_and_where(monkeypatch):
     gains, certificate = solve_block_lmi(problem, "c", expected="refuted")
     assert gains is None and certificate.status == "inconclusive"
     assert (certificate.claim, certificate.set) == ("c", "blocks e; decay 0 1/s")
+    assert certificate.method == ("block LMI (1 block) solved by cvxpy + Clarabel: no gain passed the exact re-check, "
+                                  "and no dual certificate was found")
     assert certificate.seconds == 2.5
 
 

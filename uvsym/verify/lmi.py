@@ -326,8 +326,8 @@ def solve_block_lmi(problem: BlockLMI, claim: str = "block LMI", set_description
     started = time.perf_counter()
     alpha = float(problem.decay)
     where = set_description or f"blocks {', '.join(problem.names)}; decay {alpha:g} 1/s"
-    method = (f"block LMI ({len(problem.sizes)} blocks, cvxpy + Clarabel), re-checked by exact rational LDL^T; "
-              "infeasibility by an exact dual certificate")
+    blocks = f"{len(problem.sizes)} block{'s' if len(problem.sizes) != 1 else ''}"
+    solved = f"block LMI ({blocks}) solved by cvxpy + Clarabel"
     scalings = (_balance(problem), np.ones(len(problem.omega)))
     for rate, D in ((r, D) for r in (DESIGN_MARGIN * alpha + 1e-6, alpha) for D in scalings):
         solution = _solve(problem, rate, D)
@@ -336,14 +336,17 @@ def solve_block_lmi(problem: BlockLMI, claim: str = "block LMI", set_description
         P, K = solution
         ok, margin = _exact_check(problem, P, K)
         if ok:
+            method = f"{solved}; its P and K re-checked by exact rational LDL^T (margin: the smallest pivot)"
             certificate = Certificate(claim, where, method, "proved", expected, margin=float(margin),
                                       seconds=time.perf_counter() - started,
                                       details={"K": [k.tolist() for k in K], "P": [p.tolist() for p in P]})
             return BlockGains(tuple(K), tuple(P), certificate), certificate
     evidence = dual_certificate(problem)
     if evidence is not None:
+        method = f"block LMI ({blocks}) infeasible: a dual certificate Z ({evidence['source']}) with {CHECK}"
         return None, Certificate(claim, where, method, "refuted", expected, seconds=time.perf_counter() - started,
                                  counterexample=evidence)
+    method = f"{solved}: no gain passed the exact re-check, and no dual certificate was found"
     return None, Certificate(claim, where, method, "inconclusive", expected, seconds=time.perf_counter() - started,
                              reason="neither a gain that passes the exact re-check nor a dual certificate was found")
 
