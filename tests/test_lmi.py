@@ -125,7 +125,7 @@ def test_unroundable_unobservable_direction_is_inconclusive_with_method_and_reas
                                          expected="refuted")
     assert gains is None and certificate.status == "inconclusive"
     assert certificate.expected == "refuted" and not certificate.as_expected
-    assert certificate.method.startswith("block LMI (1 blocks, cvxpy + Clarabel)")
+    assert certificate.method.startswith("block LMI (1 block) solved by cvxpy + Clarabel: no gain passed")
     assert certificate.reason == "neither a gain that passes the exact re-check nor a dual certificate was found"
 
 
