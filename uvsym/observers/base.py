@@ -53,7 +53,8 @@ class Observer:
     unchecked); state, reads_y, reads_u, params, publishes: the Signals of
     s, y, u, p and out; p0: (n_p,) default parameters; dt: sample period (s); init(y0, u0, p) ->
     s0 (None: zeros); error_dynamics: symbolic error dynamics for verify, or None; equations:
-    further named Functions a report may render (e.g. the continuous right-hand side).
+    further named Functions a report may render (e.g. the continuous right-hand side; a Gaussian
+    filter keeps its GaussianFilter under "filter").
     """
 
     name: str

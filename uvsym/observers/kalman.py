@@ -16,8 +16,10 @@ made (:func:`cholesky`): > 0 iff each matrix factorised was positive definite (t
 As an :class:`~uvsym.observers.base.Observer` (:func:`filter_observer`) the state is
 ``s = [xhat_{k|k-1} (n); tril(P_{k|k-1}) (n (n + 1) / 2)]`` (lower triangle, column by column)
 and one step publishes ``<x>_hat`` (``xhat_{k|k}``), ``r_<y>``, ``loglik``, ``pd_margin`` and
-``skipped``. A measurement vector holding a NaN is not used: the update is skipped (prior kept,
-loglik 0), the prediction made, and ``skipped`` is 1 at that sample (documented behaviour, tested).
+``skipped``; it keeps the filter in ``equations["filter"]`` (a report renders its structured form,
+:func:`uvsym.report.equations.filter_equations`). A measurement vector holding a NaN is not
+used: the update is skipped (prior kept, loglik 0), the prediction made, and ``skipped`` is 1 at
+that sample (documented behaviour, tested).
 :func:`run_filter` runs any such observer on recorded data and raises
 :class:`~uvsym.errors.CovarianceError` naming the first sample whose margin is not positive.
 """
@@ -273,7 +275,7 @@ def filter_observer(filt: GaussianFilter, description: str) -> Observer:
                     reads_u=system.u.renamed(group="input"),
                     publishes=system.x.renamed(suffix="_hat", group="estimate")
                     + system.y.renamed(prefix="r_", group="residual") + diagnostics,
-                    init=lambda y0, u0, p: s0, description=description)
+                    init=lambda y0, u0, p: s0, equations={"filter": filt}, description=description)
 
 
 def run_filter(obs: Observer, Y, U, p=None, s0=None) -> tuple[np.ndarray, np.ndarray]:

@@ -27,11 +27,14 @@ def claim_rows(certificates) -> list[dict]:
 
 
 def claims_table(rows: list[dict]) -> str:
-    """Markdown table of :func:`claim_rows`; a status other than the expected one in bold."""
-    return markdown_table(["claim", "set", "method", "status", "expected", "margin"],
-                          [[r["claim"], r["set"], r["method"], f"**{r['status']}**" if r["status"] != r["expected"]
-                            else r["status"], r["expected"], "-" if r["margin"] is None else f"{r['margin']:.3g}"]
-                           for r in rows])
+    """Markdown table of :func:`claim_rows`: statement, set, method, status, margin; a status other
+    than the expected one in bold, with the expected one beside it."""
+    def status(row: dict) -> str:
+        same = row["status"] == row["expected"]
+        return row["status"] if same else f"**{row['status']}** (expected {row['expected']})"
+    return markdown_table(["statement", "set", "method", "status", "margin"],
+                          [[r["claim"], r["set"], r["method"], status(r),
+                            "-" if r["margin"] is None else f"{r['margin']:.3g}"] for r in rows])
 
 
 def counterexamples(rows: list[dict]) -> str:

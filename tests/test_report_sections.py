@@ -1,0 +1,17 @@
+"""The claims table every report shares: statement, set, method, status, margin."""
+
+from uvsym.report.sections import claims_table
+
+ROWS = [{"claim": "decay at 20 1/s", "set": "the linearisation", "method": "LMI, re-checked exactly",
+         "status": "proved", "expected": "proved", "margin": 0.000347},
+        {"claim": "negative control", "set": "a vertex", "method": "Routh-Hurwitz", "status": "proved",
+         "expected": "refuted", "margin": None}]
+
+
+def test_the_claims_table_has_the_five_columns_and_flags_an_unexpected_status():
+    header, rule, first, second = claims_table(ROWS).splitlines()
+    assert [c.strip() for c in header.strip("|").split("|")] == ["statement", "set", "method", "status", "margin"]
+    assert rule == "|---|---|---|---|---|"
+    assert [c.strip() for c in first.strip("|").split("|")] == ["decay at 20 1/s", "the linearisation",
+                                                               "LMI, re-checked exactly", "proved", "0.000347"]
+    assert [c.strip() for c in second.strip("|").split("|")][3:] == ["**proved** (expected refuted)", "-"]
