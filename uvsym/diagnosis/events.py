@@ -2,10 +2,11 @@
 
 Schema (stable), one vocabulary for every detector: a JSON list of ``{"t": s, "event": one of
 EVENTS, "target": signal name or null, "kind": fault kind or null, "value": number or null,
-"detector": the deciding block's name or null}``. ``target`` names the input (an actuator) or the
+"detector": the deciding block's name or null, "std": number or null}``. ``target`` names the input (an actuator) or the
 output (a sensor) the decision is about, or for ``ambiguous`` the candidates joined by ``|``;
 ``value`` is a fault size in the kind's unit (``-`` for kinds that scale a signal, else the
-signal's unit).
+signal's unit); ``std``, where the detector states one, is the standard deviation of ``value`` under
+the noise model it was told (same unit; ``value +- 2 std`` is an approximate 95 % interval).
 
 Events: ``detected`` (something is wrong), ``isolated`` (it is this target), ``identified`` (its
 size), ``cleared`` (the fault, or with no target every fault, is gone), ``ambiguous`` (the data
@@ -30,7 +31,7 @@ ALARMS = ("detected", "isolated", "identified")  # the events that say a fault i
 
 @dataclass(frozen=True)
 class Event:
-    """t (s), event (one of EVENTS), target signal, fault kind, value, detector (module docstring)."""
+    """t (s), event (one of EVENTS), target signal, fault kind, value, detector, std of value (module docstring)."""
 
     t: float
     event: str
@@ -38,6 +39,7 @@ class Event:
     kind: str | None = None
     value: float | None = None
     detector: str | None = None
+    std: float | None = None
 
     def __post_init__(self):
         if self.event not in EVENTS:
@@ -45,8 +47,9 @@ class Event:
 
     def as_dict(self) -> dict:
         record = asdict(self)
-        if record["value"] is not None and not math.isfinite(record["value"]):
-            record["value"] = None
+        for key in ("value", "std"):
+            if record[key] is not None and not math.isfinite(record[key]):
+                record[key] = None
         return record
 
 

@@ -38,13 +38,15 @@ class Hypothesis:
 @dataclass(frozen=True)
 class WindowFit:
     """One window's verdicts. J_model: residual sum of squares with the model's faults fitted;
-    theta_model: (len(model),) their sizes; removal: (len(model),) the rise of J when each is
-    dropped; power: (len(model),) the J that each fault at ``values`` adds to a healthy record;
+    theta_model: (len(model),) their sizes; cov_model: (len(model), len(model)) the sizes' covariance
+    (the inverse information of the joint fit, in the sizes' units squared); removal: (len(model),) the
+    rise of J when each is dropped; power: (len(model),) the J that each fault at ``values`` adds to a healthy record;
     glr, theta, info: (len(candidates),) ``J_model - J`` per added candidate, its size, and the
     information ``|P phi|^2`` (1 / variance of the size)."""
 
     J_model: float
     theta_model: np.ndarray
+    cov_model: np.ndarray
     removal: np.ndarray
     power: np.ndarray
     glr: np.ndarray
@@ -116,7 +118,8 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     y = Z.unit(Z.n_t) - sum((c for c, _ in model_cols), np.zeros(Z.size))
     basis = np.column_stack([free] + [phi[:, None] for _, phi in model_cols])
     SB = Z.S @ basis
-    theta_model = (np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True) @ (SB.T @ y))[Z.n_t:]
+    inverse = np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True)
+    theta_model, cov_model = (inverse @ (SB.T @ y))[Z.n_t:], inverse[Z.n_t:, Z.n_t:]
     J_model = float(_schur(Z.S, basis, y[:, None])[0, 0])
     removal, power = np.zeros(len(model)), np.zeros(len(model))
     for i, (c, phi) in enumerate(model_cols):
@@ -124,7 +127,7 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
         gram = _schur(Z.S, others, np.column_stack([y + c, c + values[i] * phi]))
         removal[i], power[i] = gram[0, 0] - J_model, gram[1, 1]
     if not candidates:
-        return WindowFit(J_model, theta_model, removal, power, np.zeros(0), np.zeros(0), np.zeros(0))
+        return WindowFit(J_model, theta_model, cov_model, removal, power, np.zeros(0), np.zeros(0), np.zeros(0))
     cols = [Z.hypothesis(h) for h in candidates]
     U = np.column_stack([y - c for c, _ in cols])  # each candidate's target
     X = np.column_stack([phi for _, phi in cols])
@@ -134,4 +137,4 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     seen = xx > 1e-12 * max(float(np.max(xx)), 1e-300)
     theta = np.where(seen, ux / np.where(seen, xx, 1.0), np.nan)
     J = uu - np.where(seen, ux * np.nan_to_num(theta), 0.0)
-    return WindowFit(J_model, theta_model, removal, power, J_model - J, theta, np.where(seen, xx, 0.0))
+    return WindowFit(J_model, theta_model, cov_model, removal, power, J_model - J, theta, np.where(seen, xx, 0.0))

@@ -172,9 +172,11 @@ class ActuatorDiagnosis:
         values = np.array([d.value for d in self.decided.values()])
         return fit_window(self.bank, rows, model, values, candidates)
 
-    def _log(self, k: int, event: str, actuator: str | None, kind: str | None = None, value=None) -> None:
+    def _log(self, k: int, event: str, actuator: str | None, kind: str | None = None, value=None,
+             std: float | None = None) -> None:
         t = round(float(self._t[k]), 9)  # the sample time, without the float noise of k * dt
-        self.events.append(Event(t, event, actuator, kind, None if value is None else float(value), DETECTOR))
+        self.events.append(Event(t, event, actuator, kind, None if value is None else float(value), DETECTOR,
+                                 std))
 
     def _decide(self, k: int) -> None:
         rows = np.arange(k - self.W + 1, k + 1)
@@ -211,8 +213,8 @@ class ActuatorDiagnosis:
             if not decided.identified:
                 if not explained:
                     continue
-                decided.value, decided.identified = self._size(k, a), True
-                self._log(k, "identified", self.labels[a], decided.hypothesis.kind.name, decided.value)
+                (decided.value, std), decided.identified = self._size(k, a), True
+                self._log(k, "identified", self.labels[a], decided.hypothesis.kind.name, decided.value, std)
                 continue
             gone = fit.power[i] > self.h_detect and fit.removal[i] < self.h_iso
             decided.clear_streak = decided.clear_streak + 1 if gone else 0
@@ -220,20 +222,23 @@ class ActuatorDiagnosis:
                 del self.decided[a]
                 self._log(k, "cleared", self.labels[a], decided.hypothesis.kind.name)
 
-    def _size(self, k: int, actuator: int) -> float:
+    def _size(self, k: int, actuator: int) -> tuple[float, float]:
         """The size of a decided fault fitted on the record since its onset (at most isolation_window_s),
-        Gauss-Newton through the exact force model until the size moves less than 1e-6 of itself."""
+        Gauss-Newton through the exact force model until the size moves less than 1e-6 of itself, and its
+        standard deviation under the residual's noise model (the joint fit's inverse information)."""
         decided = self.decided[actuator]
         rows = np.arange(max(decided.hypothesis.onset, k - self.W_iso + 1), k + 1)
         index = list(self.decided).index(actuator)
+        std = np.nan
         for _ in range(_GAUSS_NEWTON_STEPS):
-            value = float(self._fit(rows, []).theta_model[index])
+            fit = self._fit(rows, [])
+            value, std = float(fit.theta_model[index]), float(np.sqrt(max(fit.cov_model[index, index], 0.0)))
             if not np.isfinite(value):
                 break
             step, decided.value = value - decided.value, value
             if abs(step) <= 1e-6 * max(abs(value), 1e-12):
                 break
-        return decided.value
+        return decided.value, std
 
     def _revise(self, k: int, rows: np.ndarray, J_model: float) -> None:
         """Re-judge each decided fault's kind, once a window, on a window wholly after its onset: a rival
@@ -357,13 +362,19 @@ class ActuatorDiagnosis:
         self._lead, self._lead_streak, self._undecided_streak = None, 0, 0
 
     def _onset(self, k: int, lead: Hypothesis) -> int:
-        """The change time (sample) that fits ``lead`` best over the window before the episode and since."""
-        first = max(0, self._episode - self.W + 1)
+        """The change time (sample) that fits ``lead`` best on the record since the episode's first alarm
+        and up to ``isolation_window_s`` (at least ``window_s``) before it: 40 candidates across that span,
+        then every sample around the best of them (the episode's start where no onset lets it be seen)."""
+        first = max(0, min(self._episode - self.W + 1, k - self.W_iso + 1))
         rows = np.arange(first, k + 1)
-        best, best_J = self._episode, np.inf
-        for onset in range(first, self._episode + 1, max(1, (self._episode - first) // 40)):
+
+        def misfit(onset: int) -> float:
             fit = self._fit(rows, [Hypothesis(lead.actuator, lead.kind, onset)])
-            J = fit.J_model - fit.glr[0]
-            if J < best_J:
-                best, best_J = onset, J
-        return best
+            J = float(fit.J_model - fit.glr[0])
+            return J if np.isfinite(J) else np.inf
+
+        spacing = max(1, (self._episode - first) // 40)
+        coarse = min(range(first, self._episode + 1, spacing), key=misfit)
+        if not np.isfinite(misfit(coarse)):  # the hypothesis is not seen at any onset
+            return self._episode
+        return min(range(max(first, coarse - spacing + 1), min(self._episode, coarse + spacing - 1) + 1), key=misfit)
