@@ -50,8 +50,9 @@ def test_the_ekf_of_a_dc_motor_renders_prediction_gain_and_update_with_its_jacob
     R, L, k, J, b = P0
     Adt = 0.01 * np.array([[-R / L, -k / L], [k / J, -b / J]])
     taylor = sum(np.linalg.matrix_power(Adt, m) / np.prod(range(1, m + 1)) for m in range(5))
-    F_line, H_line = parts["jacobians"]
-    assert F_line.startswith("F_k = ") and H_line.startswith("H_k = ")
+    A_line, F_line, H_line = parts["jacobians"]
+    assert A_line.startswith("A = ") and F_line.startswith("F_k = ") and H_line.startswith("H_k = ")
+    np.testing.assert_allclose(_matrix(A_line.split(r"\quad")[0]), Adt / 0.01)
     np.testing.assert_allclose(_matrix(F_line), taylor, rtol=1e-7)
     np.testing.assert_array_equal(_matrix(H_line), [[0.0, 1.0]])
     np.testing.assert_allclose(_matrix(parts["prediction"][2]), 1e-4 * np.eye(2))
@@ -60,9 +61,9 @@ def test_the_ekf_of_a_dc_motor_renders_prediction_gain_and_update_with_its_jacob
 def test_an_entry_above_the_size_guard_is_named_and_the_note_says_what_was_skipped():
     parts = filter_equations(ekf(dc_motor(friction=0.02), dt=0.01, Q=1e-4, R=1e-2, P0=1.0).equations["filter"],
                              max_operations=12)
-    F_line, H_line = parts["jacobians"]
+    A_line, F_line, H_line = parts["jacobians"]
     assert "F_{2,2}" in F_line and "F_{1,2}" in F_line  # the speed column goes through tanh
-    notes = {re.match(r"\$(F_\{\d,\d\})\$", n).group(1): n for n in parts["jacobians"].skipped}
+    notes = {re.match(r"\$([AFH]_\{\d,\d\})\$", n).group(1): n for n in parts["jacobians"].skipped}
     assert "F_{2,2}" in notes
     size = int(re.search(r": (\d+) operations written out, more than the guard of 12; not shown", notes["F_{2,2}"])
                .group(1))
@@ -77,7 +78,7 @@ def test_an_entry_above_the_size_guard_is_named_and_the_note_says_what_was_skipp
 def test_an_observer_keeping_its_filter_renders_the_structured_form():
     lines = observer_equations(ekf(dc_motor(friction=0.02), dt=0.01, Q=1e-4, R=1e-2, P0=1.0, steps=2))
     assert r"S_k = H_k P_{k|k-1} H_k^{\top} + R" in lines
-    assert any(line.startswith(r"F(x, u) = \text{2 RK4 steps of }") for line in lines)
+    assert any(line.startswith(r"F(\mathbf{x}, \mathbf{u}) = \text{2 RK4 steps of }") for line in lines)
     assert lines.skipped and all("more than the guard of 400" in note for note in lines.skipped)
 
 
@@ -87,7 +88,7 @@ def test_the_ukf_shows_its_weights_and_the_closed_form_of_an_affine_output():
     weights = parts["prediction"][1]
     assert r"\lambda = \alpha^2 (n + \kappa) - n = -1.5" in weights
     assert r"w^{m}_0 = -3,\ w^{c}_0 = -0.25,\ w_i = 1" in weights
-    assert parts["jacobians"][0].startswith(r"H = \frac{\partial h}{\partial x} = \begin{bmatrix} 0 & 1")
+    assert parts["jacobians"][0].startswith(r"H = \frac{\partial h}{\partial \mathbf{x}} = \begin{bmatrix} 0 & 1")
     assert r"K_k = P_{xz} P_{zz}^{-1}" in parts["gain"]
 
 

@@ -199,18 +199,21 @@ def filter_equations(filt, digits: int = 4, max_operations: int = MAX_OPERATIONS
     x = ca.vertcat(*[ca.SX.sym(name) for name in system.x.names])
     u = ca.vertcat(*[ca.SX.sym(name) for name in system.u.names]) if system.u.size else ca.SX(0, 1)
     names = {name: signal_latex(name) for group in (system.x, system.u) for name in group.names}
-    state = r"x = \begin{bmatrix} " + r" \\ ".join(signal_latex(v) for v in system.x.names) + r" \end{bmatrix}"
+    state = r"\mathbf{x} = \begin{bmatrix} " + r" \\ ".join(signal_latex(v) for v in system.x.names) + r" \end{bmatrix}"
     if system.discrete:
         dynamics = function_equations(system.f, [system.x, system.u, system.d, system.p], [(system.x, "next")],
                                       {2: np.zeros(system.d.size), 3: system.p0}, digits, max_operations)
-        discrete_map = r"F(x, u) = x^{+}\quad \text{(the model's own map)}"
+        discrete_map = r"F(\mathbf{x}, \mathbf{u}) = \mathbf{x}^{+}\quad \text{(the model's own map)}"
     else:
         dynamics = function_equations(system.f, [system.x, system.u, system.d, system.p], [(system.x, "dot")],
                                       {2: np.zeros(system.d.size), 3: system.p0}, digits, max_operations)
         steps = filt.settings["steps"]
-        discrete_map = (rf"F(x, u) = \text{{{steps} RK4 step{'s' if steps > 1 else ''} of }} \dot{{x}} = f(x, u)"
+        discrete_map = (rf"F(\mathbf{{x}}, \mathbf{{u}}) = \text{{{steps} RK4 step{'s' if steps > 1 else ''} of }} "
+                        r"\dot{\mathbf{x}} = f(\mathbf{x}, \mathbf{u})"
                         rf"\text{{ over }} \Delta t = {filt.dt:g}\,\mathrm{{s}}")
-    output = function_equations(system.h, [system.x, system.u, system.p], [(system.y, "")], {2: system.p0}, digits,
+    measured = Signals(tuple(f"y.{name}" if name in system.x.names + system.u.names else name
+                             for name in system.y.names), system.y.units)  # y = x reads y_x = x
+    output = function_equations(system.h, [system.x, system.u, system.p], [(measured, "")], {2: system.p0}, digits,
                                 max_operations)
     model = Equations([state, *dynamics, discrete_map, *output], dynamics.skipped + output.skipped)
     h = system.h(x, u, p0)
@@ -221,9 +224,14 @@ def filter_equations(filt, digits: int = 4, max_operations: int = MAX_OPERATIONS
         F_k = _jacobian(transition(system, filt.dt, filt.settings["steps"])(x, u, p0), x, "F", names, digits,
                         max_operations)
         H_k = _jacobian(h, x, "H", names, digits, max_operations)
-        jacobians = Equations([r"F_k = \frac{\partial F}{\partial x}(\hat{x}_{k|k}, u_k) = " + F_k[0],
-                               r"H_k = \frac{\partial h}{\partial x}(\hat{x}_{k|k-1}, u_k) = " + H_k[0]],
+        jacobians = Equations([r"F_k = \frac{\partial F}{\partial \mathbf{x}}(\hat{x}_{k|k}, u_k) = " + F_k[0],
+                               r"H_k = \frac{\partial h}{\partial \mathbf{x}}(\hat{x}_{k|k-1}, u_k) = " + H_k[0]],
                               F_k.skipped + H_k.skipped)
+        if not system.discrete:  # the continuous model's Jacobian, which F_k integrates
+            A = _jacobian(system.f(x, u, ca.DM.zeros(system.d.size), p0), x, "A", names, digits, max_operations)
+            jacobians = Equations([r"A = \frac{\partial f}{\partial \mathbf{x}} = " + A[0]
+                                   + r"\quad \text{(}F_k\text{ is the Jacobian of its RK4 map)}",
+                                   *jacobians], A.skipped + jacobians.skipped)
         prediction = [r"\hat{x}_{k+1|k} = F(\hat{x}_{k|k}, u_k)", r"P_{k+1|k} = F_k P_{k|k} F_k^{\top} + Q",
                       f"Q = {Q}"]
         gain = [r"S_k = H_k P_{k|k-1} H_k^{\top} + R", f"R = {R}", r"K_k = P_{k|k-1} H_k^{\top} S_k^{-1}"]
@@ -244,7 +252,7 @@ def filter_equations(filt, digits: int = 4, max_operations: int = MAX_OPERATIONS
                       r"\left(F(\mathcal{X}_i, u_k) - \hat{x}_{k+1|k}\right)^{\top} + Q", f"Q = {Q}"]
         if s["affine_closed_form"]:
             H = _jacobian(h, x, "H", names, digits, max_operations)
-            jacobians = Equations([r"H = \frac{\partial h}{\partial x} = " + H[0]
+            jacobians = Equations([r"H = \frac{\partial h}{\partial \mathbf{x}} = " + H[0]
                                    + r"\quad \text{(h affine in x: the transform is exact)}"], H.skipped)
             gain = [r"\hat{z}_k = h(\hat{x}_{k|k-1}, u_k),\quad P_{zz} = H P_{k|k-1} H^{\top} + R,\quad "
                     r"P_{xz} = P_{k|k-1} H^{\top}", f"R = {R}"]
