@@ -8,13 +8,16 @@ import numpy as np
 
 from derivations.usv_fukf_mmae import analysis as A
 from derivations.usv_fukf_mmae.campaign import campaign_section, run_study_campaign
-from derivations.usv_fukf_mmae.experiment import run
+from derivations.usv_fukf_mmae.experiment import disturbed_plant, run
 from derivations.usv_fukf_mmae.figures import FIGURES, draw_all
 from derivations.usv_fukf_mmae.observer_sets import usv_fukf_mmae
 from derivations.usv_fukf_mmae.paper import CITATION, eq4_check, eq11_check, eq18_check
 from derivations.usv_fukf_mmae.scenario import SCENARIO, block_table, parsed, read, thruster_faults
+from uvsym.observers.mmae_design import bank_filters
 from uvsym.report import markdown_table, write_json
+from uvsym.report.equations import equations_markdown, filter_equations
 from uvsym.report.sections import c_package, c_section
+from uvsym.sim.fields import Fields
 
 __all__ = ["build", "TARGETS"]
 
@@ -127,6 +130,19 @@ def _claims(banks: dict) -> list[list[str]]:
              f"UKF vs EKF |alpha_hat - alpha|: {errors}"]]
 
 
+def filters_section(table: dict, model: str = "left") -> str:
+    """The Markdown of the ``model`` filter of both banks in their structured form, derived from the
+    filters the scenario designs (model, Jacobians, prediction, gain, update)."""
+    parts = {method: filter_equations(bank_filters(Fields(block_table(table, method), f"blocks.{method}"),
+                                                   disturbed_plant(), table["step"])[model])
+             for method in ("ukf", "ekf")}
+    ekf = {key: part for key, part in parts["ekf"].items() if key != "model"}
+    return (f"The `{model}` model's filters, as uvsym derives them from the scenario's plant and the bank's "
+            f"tuning (parameters at their values, the random force at 0). The UKF:\n\n"
+            f"{equations_markdown(parts['ukf'])}\n\n<details>\n<summary>The EKF of the same model (same model "
+            f"equations)</summary>\n\n{equations_markdown(ekf)}\n\n</details>")
+
+
 def _report(r: dict, table: dict, faults) -> str:
     eq4, eq11 = r["paper_checks"]["eq4"], r["paper_checks"]["eq11"]
     eq4_rows = [[row, f"{p:.6g}", f"{d:.6g}", f"{p - d:.3g}"] for row, p, d in
@@ -201,6 +217,10 @@ disturbance seed {table["disturbance_seed"]}). Sensor noise (standard deviations
 ## What the paper leaves out, and uvsym's choices
 
 {markdown_table(["choice", "value"], tuning)}
+
+## The filters' equations (derived by CasADi, not typed)
+
+{filters_section(table)}
 
 ## Where the paper is wrong, checked by machine
 

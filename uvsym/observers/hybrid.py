@@ -248,7 +248,10 @@ def hybrid_observer(plant: System, dec: Decoupling, K1, L, dt: float, *, estimat
                     tuple(plant.x.units[i] for i in dec.iz2) + tuple(f"{plant.y.units[i]} s" for i in dec.iw2[:n_int]),
                     group="state")
     kind = "fault estimator (eq. 18)" if q else ("detection observer (eq. 6)" if n2 else "unknown-input observer")
+    symbols = [ca.SX.sym(k, size) for k, size in zip("syup", (state.size, plant.y.size, plant.u.size, plant.p.size))]
+    continuous = ca.Function(f"{name}_continuous", symbols, [rhs(*symbols)], list("syup"), ["s_dot"])
     return observer(name, step=step, dt=dt, p0=plant.p0, params=plant.p.renamed(group="parameter"), state=state,
+                    equations={"continuous": continuous},
                     reads_y=plant.y.renamed(group="measurement"), reads_u=plant.u.renamed(group="input"),
                     publishes=plant.x.renamed(suffix="_hat", group="estimate") +
                     plant.y.renamed(prefix="r_", group="residual") + faults.renamed(suffix="_hat", group="estimate"),

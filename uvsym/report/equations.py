@@ -91,26 +91,29 @@ def operations(expression) -> int:
 
 
 def entry_latex(expression, names: dict[str, str], digits: int, max_operations: int,
-                label: str) -> tuple[str | None, str | None]:
+                label: str, zero_below: float = 0.0) -> tuple[str | None, str | None]:
     """(LaTeX, None) of a scalar SX, or (None, note) when written out it has more than
-    ``max_operations`` operations; the note names ``label`` (LaTeX) and the count."""
+    ``max_operations`` operations; the note names ``label`` (LaTeX) and the count. zero_below: as
+    :func:`uvsym.sympy_bridge.latex`."""
     size = operations(expression)
     if size > max_operations:
         more = "at least " if size > MAX_WALK else ""
         return None, (f"${label}$: {more}{size} operations written out, more than the guard of "
                       f"{max_operations}; not shown")
-    return latex(sp.sympify(to_sympy(expression)), digits, names=names), None
+    return latex(sp.sympify(to_sympy(expression)), digits, zero_below, names=names), None
 
 
 def function_equations(function: ca.Function, inputs: list[Signals], outputs: list[tuple[Signals, str]],
                        values: dict | None = None, digits: int = 6,
-                       max_operations: int = MAX_OPERATIONS) -> Equations:
+                       max_operations: int = MAX_OPERATIONS, zero_below: float = 0.0) -> Equations:
     """``lhs = rhs`` LaTeX lines for every output entry of ``function``.
 
     inputs: one Signals per input of ``function`` (same sizes), naming its entries; outputs: per
     output, (Signals naming its entries, decoration) with decoration "" (plain), "dot" or "next"
     (``x^{+}``); values: input index -> numbers substituted (e.g. gains), optional. An entry with
     more than ``max_operations`` operations written out has no line, a note in ``skipped`` instead.
+    zero_below: coefficients of smaller magnitude shown as 0, those within it of 1 as 1 (rounding
+    residues; say so where it is used).
     """
     if len(inputs) != function.n_in() or len(outputs) != function.n_out():
         raise UvsymError(f"{function.name()}: give one Signals per input ({function.n_in()}) and output "
@@ -132,7 +135,7 @@ def function_equations(function: ca.Function, inputs: list[Signals], outputs: li
         for k, name in enumerate(group.names):
             lhs = signal_latex(name)
             lhs = {"": lhs, "dot": f"\\dot{{{lhs}}}", "next": f"{lhs}^{{+}}"}[decoration]
-            tex, note = entry_latex(expression[k], names, digits, max_operations, lhs)
+            tex, note = entry_latex(expression[k], names, digits, max_operations, lhs, zero_below)
             if note:
                 equations.skipped.append(note)
             else:
@@ -141,13 +144,13 @@ def function_equations(function: ca.Function, inputs: list[Signals], outputs: li
 
 
 def observer_equations(observer, continuous: bool = True, digits: int = 6,
-                       max_operations: int = MAX_OPERATIONS) -> Equations:
+                       max_operations: int = MAX_OPERATIONS, zero_below: float = 0.0) -> Equations:
     """LaTeX lines of an observer: a Gaussian filter's structured form (the parts of
     :func:`filter_equations`, one after the other) when it keeps its filter in
     ``equations["filter"]``; else its continuous form ``(xhat, y, u, p) -> xhat_dot`` when it keeps
     one with that shape (and ``continuous``), else its step ``s^+ = ..., out = ...``. The
     parameters are replaced by their default values p0; entries larger than ``max_operations``
-    are listed in ``skipped``."""
+    are listed in ``skipped``; zero_below as :func:`function_equations` (not for a filter)."""
     if "filter" in observer.equations:
         parts = filter_equations(observer.equations["filter"], digits, max_operations).values()
         return Equations([line for part in parts for line in part], [note for part in parts for note in part.skipped])
@@ -155,9 +158,10 @@ def observer_equations(observer, continuous: bool = True, digits: int = 6,
     groups = [observer.state, observer.reads_y, observer.reads_u, observer.params]
     if form is not None and form.n_in() == 4 and form.n_out() == 1 and \
             [form.numel_in(i) for i in range(4)] == [g.size for g in groups]:
-        return function_equations(form, groups, [(observer.state, "dot")], {3: observer.p0}, digits, max_operations)
+        return function_equations(form, groups, [(observer.state, "dot")], {3: observer.p0}, digits, max_operations,
+                                  zero_below)
     return function_equations(observer.step, groups, [(observer.state, "next"), (observer.publishes, "")],
-                              {3: observer.p0}, digits, max_operations)
+                              {3: observer.p0}, digits, max_operations, zero_below)
 
 
 def _jacobian(expression, x: ca.SX, symbol: str, names: dict[str, str], digits: int,
