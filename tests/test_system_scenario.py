@@ -41,7 +41,7 @@ def test_both_estimators_detect_the_speed_bias_soon_after_its_onset(shipped):
     scenario, result = shipped
     assert {"luenberger", "ukf"} <= set(result.signals)         # same names, told apart by their blocks
     events = result.events
-    assert all(set(e) == {"t", "event", "target", "kind", "value", "detector"} for e in events)
+    assert all(set(e) == {"t", "event", "target", "kind", "value", "detector", "std"} for e in events)
     for detector in ("luenberger_fd", "ukf_fd"):
         own = [e for e in events if e["detector"] == detector]
         assert own[0]["event"] == "detected" and 3.0 <= own[0]["t"] <= 3.05 and own[0]["target"] == "omega_meas"
