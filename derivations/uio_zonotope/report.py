@@ -34,6 +34,7 @@ from derivations.uio_zonotope.experiment import (
 )
 from derivations.uio_zonotope.study import FAULT_RUNS, FAULT_SEED, run_study
 from uvsym.report import markdown_table, save_svg, write_json
+from uvsym.report.equations import equations_markdown, observer_equations
 from uvsym.report.sections import claim_rows, claims_table
 
 __all__ = ["build"]
@@ -127,6 +128,20 @@ def _scenario_events() -> dict:
             for name, path in DERIVATION.scenarios.items()}
 
 
+ROUNDING_SHOWN_AS_ZERO = 1e-12  # residues of the design's products in doubles
+
+
+def observers_section() -> str:
+    """Each bank observer's step ``z^+ = F z + J u + K y``, ``xhat = z + Q y``, ``r = y - C xhat``,
+    rendered from its CasADi graph; the first in full, the others folded."""
+    parts = []
+    for k, obs in enumerate(design().bank.observers):
+        text = equations_markdown(observer_equations(obs, digits=4, zero_below=ROUNDING_SHOWN_AS_ZERO))
+        parts.append(f"**`{obs.name}`**\n\n{text}" if k == 0 else
+                     f"<details>\n<summary><code>{obs.name}</code></summary>\n\n{text}\n\n</details>")
+    return "\n\n".join(parts)
+
+
 def _report(r: dict) -> str:
     d = design()
     plant = d.plant
@@ -211,6 +226,14 @@ stated, and computed by the run that wrote this report.
 - Runs: {r['healthy_runs']} healthy runs (seed 0) and {r['fault_runs_per_case']} runs per fault case
   (seed {FAULT_SEED}), noise uniform in its box, or on its vertices in every {VERTEX_EVERY}th run.
 - Isolation: the observers that stay inside their bands for {ISOLATION_WINDOW} samples from the alarm.
+
+## The observers' equations (derived by CasADi, not typed)
+
+Each observer's step, rendered from its CasADi graph to 4 digits (the code keeps every bit):
+the state update `z^+`, the estimate `xhat = z + Q y` and the residual `r = y - C xhat`, in the
+loop's signal names; coefficients below {ROUNDING_SHOWN_AS_ZERO:g} are shown as 0.
+
+{observers_section()}
 
 ## Figures
 
