@@ -98,6 +98,10 @@ def test_operations_count_a_shared_sub_expression_at_each_use():
     shared = x * y
     assert operations(shared * ca.sin(shared)) == 8  # *, (x y) twice (3 each), sin
     assert operations(ca.SX(2.0)) == 1
+    deep = x
+    for _ in range(1500):  # deeper than Python's recursion limit: sin, +, the constant per level
+        deep = ca.sin(deep) + 1.0
+    assert operations(deep) == 3 * 1500 + 1
 
 
 def test_a_filter_of_another_method_is_refused_by_name():

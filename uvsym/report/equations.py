@@ -72,22 +72,29 @@ class Equations(list):
 
 
 def operations(expression) -> int:
-    """Operations of a scalar SX written out as one formula (a shared sub-expression counts at
-    each use, as it is printed); ``> max`` is all that matters above the DAG's own size."""
+    """Operations of a scalar SX written out as one formula, symbols and constants counted as one
+    each and a shared sub-expression at each use (as it is printed). Above ``MAX_WALK`` nodes of
+    the expression graph it is not walked: the graph's node count, a lower bound, is returned."""
     expression = ca.SX(expression)
     symbols = ca.symvar(expression)
-    dag = ca.Function("size", symbols, [expression]).n_nodes() if symbols else 1
-    if dag > MAX_WALK:
-        return dag  # at least this many once written out; not walked
+    if symbols and ca.Function("size", symbols, [expression]).n_nodes() > MAX_WALK:
+        return ca.Function("size", symbols, [expression]).n_nodes()
     memo: dict[int, int] = {}
-
-    def count(node: ca.SX) -> int:
+    stack = [expression]
+    while stack:  # post-order without recursion (a graph may be deeper than Python's stack)
+        node = stack[-1]
         key = node.element_hash()
-        if key not in memo:
-            memo[key] = 1 if node.is_symbolic() or node.is_constant() else \
-                1 + sum(count(node.dep(i)) for i in range(node.n_dep()))
-        return memo[key]
-    return count(expression)
+        if key in memo:
+            stack.pop()
+            continue
+        deps = [node.dep(i) for i in range(node.n_dep())] if not (node.is_symbolic() or node.is_constant()) else []
+        pending = [d for d in deps if d.element_hash() not in memo]
+        if pending:
+            stack.extend(pending)
+            continue
+        memo[key] = 1 + sum(memo[d.element_hash()] for d in deps)
+        stack.pop()
+    return memo[expression.element_hash()]
 
 
 def entry_latex(expression, names: dict[str, str], digits: int, max_operations: int,
