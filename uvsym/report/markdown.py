@@ -20,10 +20,12 @@ def markdown_table(header: list[str], rows: list[list]) -> str:
 
 
 def latex_matrix(matrix, digits: int = 6) -> str:
-    """A numeric matrix as a LaTeX ``bmatrix`` with ``digits`` significant digits (exact zeros as 0)."""
+    """A numeric matrix as a LaTeX ``bmatrix`` with ``digits`` significant digits (exact zeros as 0,
+    exponents as ``2.5 \\cdot 10^{-9}``)."""
     array = np.atleast_2d(np.asarray(matrix, dtype=float))
     def fmt(x: float) -> str:
-        return "0" if x == 0 else f"{x:.{digits}g}"
+        mantissa, _, exponent = ("0" if x == 0 else f"{x:.{digits}g}").partition("e")
+        return f"{mantissa} \\cdot 10^{{{int(exponent)}}}" if exponent else mantissa
     body = r" \\ ".join(" & ".join(fmt(x) for x in row) for row in array)
     return r"\begin{bmatrix} " + body + r" \end{bmatrix}"
 
