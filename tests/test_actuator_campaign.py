@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from derivations.actuator_observers.campaign import counts, metrics, targets
+from derivations.actuator_observers.campaign import counts, metrics, size_intervals, targets
 from uvsym.faults import ActuatorFault, Profile
 from uvsym.sim.scenario import load_scenario
 
@@ -35,6 +35,18 @@ def test_counts_use_only_identifiable_excited_runs_and_fault_free_false_alarms()
     met = targets(figures)
     assert not met["correct fraction >= 0.95 (identifiable, excited)"] and not met["no run crashed"]
     assert met["median isolation delay <= 5 s"]
+
+
+def test_size_intervals_count_right_decisions_against_tolerance_and_stated_std():
+    rows = [_row(case="a", size_error_std=0.5), _row(case="a", size_error_rel=0.03, size_error_std=2.5),
+            _row(case="a", isolated_kind="proportional", size_error_std=9.0),  # wrong kind: not a size case
+            _row(case="a", excited=False, size_error_std=9.0),                 # not counted
+            _row(case="b", size_error_std=None)]                               # no std stated
+    a, b = size_intervals(rows)
+    assert a == {"case": "a", "runs": 2, "within_tolerance": 1, "with_std": 2, "within_2_std": 1,
+                 "max_error_std": 2.5}
+    assert b == {"case": "b", "runs": 1, "within_tolerance": 1, "with_std": 0, "within_2_std": 0,
+                 "max_error_std": None}
 
 
 class _Result:

@@ -282,13 +282,14 @@ def test_metrics_of_a_hand_written_event_log():
               _event(7.0, "cleared", "delta_ru"),
               _event(7.5, "isolated", "X", "bias"),              # isolation delay 2.5 s
               _event(9.0, "identified", "X", "bias", 9.5),
-              _event(12.0, "identified", "X", "bias", 10.4),     # the last: 4 % too large
+              _event(12.0, "identified", "X", "bias", 10.4) | {"std": 0.2},  # the last: 4 % (2 std) too large
               _event(13.0, "ambiguous", "X|delta_ru")]
     metrics = event_metrics(TRUTH, events[::-1])                # order of the list does not matter
     assert metrics == {"events": 9, "detected": True, "detection_delay_s": pytest.approx(0.8),
                        "isolated_target": "X", "isolated_kind": "bias", "isolated_targets": "X",
                        "isolation_delay_s": pytest.approx(2.5),
-                       "identified_value": 10.4, "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
+                       "identified_value": 10.4, "identified_std": 0.2, "size_error_std": pytest.approx(2.0),
+                       "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
                        "ambiguous": True, "unexcited": False}
 
 
@@ -300,6 +301,7 @@ def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
     metrics = event_metrics(truth_row, events)
     assert metrics["false_alarms"] == 1 and metrics["detection_delay_s"] == pytest.approx(1.0)
     assert metrics["identified_value"] == 3.0 and metrics["size_error_rel"] == pytest.approx(0.7)
+    assert metrics["identified_std"] is None and metrics["size_error_std"] is None  # no std stated
     assert metrics["isolated_target"] is None and metrics["unexcited"] is True
     assert event_metrics(truth_row, [_event(32.0, "unexcited", "delta_e")])["unexcited"] is False
     healthy = {key: None for key in TRUTH} | {"n_faults": 0}

@@ -26,7 +26,7 @@ import numpy as np
 from uvsym.faults import actuator_kind
 from uvsym.observers.identification import configuration_at
 
-__all__ = ["CAMPAIGN", "metrics", "counts", "targets"]
+__all__ = ["CAMPAIGN", "metrics", "counts", "size_intervals", "targets"]
 
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
 PARALLEL = 1e-3
@@ -86,6 +86,23 @@ def counts(rows: list[dict]) -> dict:
         "campaign_median_isolation_delay_s": float(np.median(delays)) if len(delays) else float("nan"),
         "campaign_max_isolation_delay_s": float(np.max(delays)) if len(delays) else float("nan"),
     }
+
+
+def size_intervals(rows: list[dict]) -> list[dict]:
+    """Per case, over the counted runs whose standing decision names the true actuator and kind: how many
+    identified sizes lie within ``SIZE_TOLERANCE`` and within 2 of the diagnosis's stated standard
+    deviations of the truth, and the largest error in stated deviations (None: no std stated)."""
+    table = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        right = [r for r in rows if r["case"] == case and r["status"] == "ok" and r["true_actuator"] is not None
+                 and r["identifiable"] and r["excited"] and r["isolated_target"] == r["true_actuator"]
+                 and r["isolated_kind"] == r["true_kind"] and r["size_error_rel"] is not None]
+        in_std = [r["size_error_std"] for r in right if r["size_error_std"] is not None]
+        table.append({"case": case, "runs": len(right),
+                      "within_tolerance": sum(r["size_error_rel"] <= SIZE_TOLERANCE for r in right),
+                      "with_std": len(in_std), "within_2_std": sum(e <= 2.0 for e in in_std),
+                      "max_error_std": max(in_std) if in_std else None})
+    return table
 
 
 def targets(figures: dict) -> dict:

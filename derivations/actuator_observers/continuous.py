@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, targets
+from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, size_intervals, targets
 from derivations.actuator_observers.dock import cross_track_rms, dock_miss
 from derivations.actuator_observers.figures import campaign_confusion_figure, campaign_delay_figure
 from uvsym.campaign import load_campaign, run_campaign
@@ -27,7 +27,8 @@ __all__ = ["campaign_results", "corrected_docking", "TABLE_COLUMNS"]
 # the columns of campaign_results.csv (the run's wall time is left out: the file stays the same)
 TABLE_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "identifiable", "excited",
                  "detected", "detection_delay_s", "isolated_target", "isolated_kind", "isolation_delay_s",
-                 "identified_value", "size_error_rel", "false_alarms", "ambiguous", "status", "error")
+                 "identified_value", "identified_std", "size_error_rel", "size_error_std", "false_alarms", "ambiguous",
+                 "status", "error")
 
 
 def _vehicle(case: str) -> str:
@@ -67,6 +68,7 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     campaign_confusion_figure(confusion, out_dir / "campaign_confusion.svg")
     campaign_delay_figure(counted, out_dir / "campaign_delays.svg")
     return {**figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
+            "size_intervals": size_intervals(rows),
             "excluded": [{"vehicle": v, "actuator": a, "kind": k, "runs": n}
                          for (v, a, k), n in sorted(excluded.items())],
             "confusion": [{"true": t, "decided": d, "runs": n} for (t, d), n in sorted(confusion.items())]}

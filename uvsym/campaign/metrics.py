@@ -29,7 +29,7 @@ __all__ = ["ALARMS", "DETECTOR_COLUMNS", "METRIC_COLUMNS", "truth", "event_metri
 DIAGNOSIS = "diagnosis"  # the detector name of a vehicle scenario's [diagnosis]
 # the columns each detector of a scenario gets, as D:<column>
 DETECTOR_COLUMNS = ("detected", "detection_delay_s", "isolated_target", "isolation_delay_s", "identified_value",
-                    "size_error_rel", "false_alarms", "ambiguous")
+                    "identified_std", "size_error_rel", "size_error_std", "false_alarms", "ambiguous")
 # every generic column a run gets, with its type (the run's grid fields and the hook's columns follow)
 METRIC_COLUMNS = {
     "run_id": "string", "case": "string", "draw": "int64", "status": "string", "error": "string",
@@ -37,7 +37,8 @@ METRIC_COLUMNS = {
     "true_value": "float64", "onset_s": "float64", "end_s": "float64",
     "events": "int64", "detected": "bool", "detection_delay_s": "float64", "isolated_target": "string",
     "isolated_kind": "string", "isolated_targets": "string",
-    "isolation_delay_s": "float64", "identified_value": "float64", "size_error_rel": "float64",
+    "isolation_delay_s": "float64", "identified_value": "float64", "identified_std": "float64",
+    "size_error_rel": "float64", "size_error_std": "float64",
     "false_alarms": "int64", "ambiguous": "bool", "unexcited": "bool", "path_error_rms_m": "float64",
     "duration_s": "float64", "wall_s": "float64",
 }
@@ -87,8 +88,10 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     isolated_targets: every actuator isolated and not cleared then, in the order of isolation,
     joined by "|";
     isolation_delay_s: the first "isolated" event in the window naming the true actuator or sensor;
-    identified_value: the last "identified" value in the window for it (or naming none);
-    size_error_rel: ``abs(identified - true) / abs(true)`` (None when true is 0); false_alarms: alarms
+    identified_value / identified_std: the last "identified" value in the window for it (or naming none)
+    and the standard deviation the detector stated for it (None where it states none);
+    size_error_rel: ``abs(identified - true) / abs(true)`` (None when true is 0); size_error_std: the
+    error in stated standard deviations, ``abs(identified - true) / identified_std``; false_alarms: alarms
     outside the window (module docstring); ambiguous: any such event; unexcited: such an event naming
     the run's own actuator or sensor (or none: another actuator's idling is not this run's business);
     events: how many.
@@ -117,6 +120,7 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
             standing.pop(e.get("target"), None)
     decision = list(standing.values())[-1] if standing else None
     value = float(identified[-1]["value"]) if identified else None
+    std = identified[-1].get("std") if identified else None
     true_value = true["true_value"]
     return {
         "events": len(events),
@@ -127,6 +131,8 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "isolated_targets": "|".join(str(a) for a in standing) or None,
         "isolation_delay_s": isolations[0]["t"] - onset if isolations else None,
         "identified_value": value,
+        "identified_std": std,
+        "size_error_std": abs(value - true_value) / std if std and true_value is not None else None,
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
         "false_alarms": len({(e.get("detector"), e["t"]) for e in events if e["event"] in ALARMS and not in_window(e)}),
         "ambiguous": any(e["event"] == "ambiguous" for e in events),
