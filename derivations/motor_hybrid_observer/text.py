@@ -236,7 +236,8 @@ claimed at {OVERSHOOT:g} x {CORRECTED_DECAY:g} 1/s is refuted.
 The continuous right-hand side of each observer (each runs as RK4 steps every {design().observers["detection"].dt:g} s),
 rendered from its CasADi graph with the motor's parameters at their values and the gains above,
 to 4 digits (the code keeps every bit). `v` is a decoupled observer's state (zhat_1 = v + H w_1);
-coefficients below {ROUNDING_SHOWN_AS_ZERO:g} (residues of T = I - H C in doubles) are shown as 0.
+coefficients below {ROUNDING_SHOWN_AS_ZERO:g} (residues of T = I - H C in doubles) are shown as 0 and those
+within it of 1 as 1.
 
 {observers_section()}
 

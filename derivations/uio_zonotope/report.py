@@ -231,7 +231,8 @@ stated, and computed by the run that wrote this report.
 
 Each observer's step, rendered from its CasADi graph to 4 digits (the code keeps every bit):
 the state update `z^+`, the estimate `xhat = z + Q y` and the residual `r = y - C xhat`, in the
-loop's signal names; coefficients below {ROUNDING_SHOWN_AS_ZERO:g} are shown as 0.
+loop's signal names; coefficients below {ROUNDING_SHOWN_AS_ZERO:g} are shown as 0 and
+those within it of 1 as 1 (rounding residues of the design in doubles).
 
 {observers_section()}
 
