@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import atexit
 import ctypes
+import functools
 import os
 import re
 import shutil
@@ -28,7 +29,8 @@ import numpy as np
 from uvsym.codegen.cache import cached_library, library_key, memoized
 from uvsym.errors import CodegenError
 
-__all__ = ["DEFAULT_FLAGS", "FAST_FLAGS", "find_compiler", "compile_function", "compile_roll", "compile_lanes"]
+__all__ = ["DEFAULT_FLAGS", "FAST_FLAGS", "find_compiler", "compile_function", "compile_roll", "compile_lanes",
+           "vector_doubles"]
 
 # No -ffast-math: a shared library built with it switches the whole process to flush-to-zero
 # on load (crtfastmath), which silently changes every other float computation in Python.
@@ -47,6 +49,20 @@ def find_compiler() -> str | None:
         if candidate and shutil.which(candidate):
             return shutil.which(candidate)
     return None
+
+
+@functools.cache
+def vector_doubles() -> int:
+    """Doubles in one vector register of the processor the compiler builds for with ``-march=native``:
+    8 with AVX-512F, 4 with AVX, else 2 (asked of the compiler's predefined macros, once per process;
+    2 without a compiler)."""
+    compiler = find_compiler()
+    if compiler is None:
+        return 2
+    done = subprocess.run([compiler, "-march=native", "-dM", "-E", "-x", "c", os.devnull], capture_output=True,
+                          text=True)
+    macros = set(re.findall(r"#define (\w+)", done.stdout)) if done.returncode == 0 else set()
+    return 8 if "__AVX512F__" in macros else 4 if "__AVX__" in macros else 2
 
 
 def _build_dir() -> Path:
@@ -129,7 +145,7 @@ _POINTER = ctypes.POINTER(ctypes.c_double)
 def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...]):
     """roll(z0, W, out) -> z_end calling ``symbol`` of ``library``; ``lanes``: () or (L,), the trailing axis."""
     n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
-    function = getattr(ctypes.CDLL(str(library)), symbol)
+    function = getattr(ctypes.CDLL(str(library)), symbol)  # roll.library below: its path
     function.argtypes = [_POINTER, _POINTER, _POINTER, _POINTER, ctypes.c_long]
 
     def roll(z0: np.ndarray, W: np.ndarray, out: np.ndarray) -> np.ndarray:
@@ -145,6 +161,7 @@ def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...
             raise CodegenError(f"{step.name()} failed inside the compiled loop")
         return z_end
 
+    roll.library = library
     return roll
 
 
@@ -218,13 +235,14 @@ static void {name}_lanes_step(const double* restrict in0, const double* restrict
   }}
 }}
 int {name}_lanes_roll(const double* z0, const double* W, double* z_end, double* O, long N) {{
-  double z[{n_z} * {L}], zn[{n_z} * {L}];
-  memcpy(z, z0, sizeof z);
+  double a[{n_z} * {L}], b[{n_z} * {L}];
+  double *z = a, *zn = b, *swap;
+  memcpy(z, z0, sizeof a);
   for (long k = 0; k < N; ++k) {{
     {name}_lanes_step(z, W + k * {n_w} * {L}, zn, O + k * {n_out} * {L});
-    memcpy(z, zn, sizeof z);
+    swap = z; z = zn; zn = swap;  /* the next state becomes the state: no copy */
   }}
-  memcpy(z_end, z, sizeof z);
+  memcpy(z_end, z, sizeof a);
   return 0;
 }}
 """
@@ -281,6 +299,8 @@ def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_F
 
     # not builtins: gcc would otherwise fuse sin and cos of one angle into a sincos it cannot vectorise
     not_builtin = tuple(f"-fno-builtin-{name}" for name in _VECTOR_MATH)
-    library = _build(step, recipe, (*flags, *not_builtin, "-fopenmp-simd", "-Wl,-z,defs"), ("-lmvec", "-lm"),
-                     generated=source)
+    # gcc prefers 256-bit vectors on AVX-512 processors: lanes that fill a 512-bit register ask for it
+    wide = ("-mprefer-vector-width=512",) if vector_doubles() == 8 and lanes % 8 == 0 else ()
+    library = _build(step, recipe, (*flags, *not_builtin, *wide, "-fopenmp-simd", "-Wl,-z,defs"),
+                     ("-lmvec", "-lm"), generated=source)
     return _roller(step, library, f"{step.name()}_lanes_roll", (lanes,))

@@ -29,7 +29,7 @@ from typing import Sequence
 import numpy as np
 
 from uvsym.codegen.cache import frozen
-from uvsym.codegen.compile import compile_lanes
+from uvsym.codegen.compile import compile_lanes, vector_doubles
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.result import Signal, SimResult
@@ -38,12 +38,22 @@ from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import PreparedRun, observer_blocks, prepare_run, scenario_arguments
 from uvsym.sim.step_error import checked_steps
 
-__all__ = ["LANES", "simulate_batch", "run_lanes"]
+__all__ = ["LANES", "default_lanes", "simulate_batch", "run_lanes"]
 
-LANES = 4  # trajectories per compiled step: one AVX2 vector; 8 and 16 measured slower (benchmarks/campaign.py)
+LANES = 4  # trajectories per compiled step on AVX2 and AVX-512 processors (see default_lanes)
 
 
-def simulate_batch(scenarios: Sequence, *, lanes: int = LANES, substeps: int = 1, compiled: bool = True,
+def default_lanes() -> int:
+    """Trajectories per compiled step on this processor: one vector of doubles, at most ``LANES``.
+
+    On AVX-512 (8 doubles) the docking loop's lanes measured slower at 8 than at 4 (256 against 220 ns
+    per trajectory-step, 10,000 steps, benchmarks/campaign.py): its steps stream about 1.1 KB of inputs
+    and outputs each, and the wider step waits on memory; a processor with 2 doubles per vector gets 2.
+    """
+    return min(vector_doubles(), LANES)
+
+
+def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: int = 1, compiled: bool = True,
                    supervisor=None) -> list[SimResult]:
     """Each scenario run as :func:`simulate_scenario` (method ``fast``; for a SystemScenario
     :func:`~uvsym.sim.system_scenario.simulate_system_scenario`, whose own substeps hold) would, in
@@ -51,8 +61,9 @@ def simulate_batch(scenarios: Sequence, *, lanes: int = LANES, substeps: int = 1
 
     Scenarios share a loop when they share the model object (as loads of one file, or ``dataclasses.replace``
     of one scenario, do), have equal controllers, observers, sensor faults, step and duration;
-    each such group runs in lanes. Results are in the order of ``scenarios``; meta as
-    :func:`simulate_scenario`'s plus ``lanes`` (lanes per compiled step), ``wall_s`` being the group's.
+    each such group runs in lanes (``lanes`` per compiled step; None: :func:`default_lanes`). Results are
+    in the order of ``scenarios``; meta as :func:`simulate_scenario`'s plus ``lanes``, ``wall_s`` being the
+    group's.
 
     Raises
     ------
@@ -103,7 +114,7 @@ def simulate_batch(scenarios: Sequence, *, lanes: int = LANES, substeps: int = 1
     return results
 
 
-def _system_lanes(scenarios: list, lanes: int, compiled: bool) -> list[SimResult]:
+def _system_lanes(scenarios: list, lanes: int | None, compiled: bool) -> list[SimResult]:
     """Scenarios over one shared wired step, in lanes; each result as simulate_system_scenario gives it."""
     from uvsym.sim.system_scenario import decided, scenario_inputs, scenario_meta_arguments
     from uvsym.sim.system_simulation import wired_meta
@@ -125,10 +136,10 @@ def _diagnosed(scenario: Scenario, result: SimResult) -> list[dict]:
     return [event.as_dict() for event in diagnosis.events]
 
 
-def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool = True,
+def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled: bool = True,
               names: Sequence[str] | None = None) -> list[SimResult]:
     """Runs prepared on ONE shared loop step (:func:`prepare_run` with ``loop=``, or wired loops of one
-    shape) and the same grid, ``lanes`` at a time.
+    shape) and the same grid, ``lanes`` at a time (None: :func:`default_lanes`).
 
     Returns one SimResult per run (meta: the run's, ``lanes``, ``wall_s`` and ``build_s`` of the
     batch). ``names`` label the runs in errors (default: their index). Falls back to one scalar run
@@ -136,6 +147,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int = LANES, compiled: bool
     """
     if not runs:
         return []
+    lanes = default_lanes() if lanes is None else lanes
     loop, N = runs[0].loop, runs[0].W.shape[0] - 1
     for i, run in enumerate(runs):
         if run.loop.step is not loop.step or run.W.shape != runs[0].W.shape:

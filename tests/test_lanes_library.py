@@ -1,0 +1,78 @@
+"""The lanes' compiled library: its width from the processor, its math through libmvec's vector
+functions, and lanes equal to the scalar roll of the same step (uvsym.codegen.compile)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from uvsym.codegen.compile import compile_lanes, compile_roll, find_compiler, vector_doubles
+from uvsym.sim.batch import LANES, default_lanes
+
+pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+
+
+def _step() -> ca.Function:
+    """A small loop step z' = (z0 + dt cos(w0 z1), z1 + dt sin(z0) exp(-w1^2)), out = (atan2(z1, z0), z0 z1)."""
+    z, w = ca.SX.sym("z", 2), ca.SX.sym("w", 2)
+    dt = 0.01
+    z_next = ca.vertcat(z[0] + dt * ca.cos(w[0] * z[1]), z[1] + dt * ca.sin(z[0]) * ca.exp(-w[1] ** 2))
+    return ca.Function("lanes_probe", [z, w], [z_next, ca.vertcat(ca.atan2(z[1], z[0]), z[0] * z[1])])
+
+
+def _cpu_flags() -> set[str]:
+    text = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
+    line = re.search(r"^flags\s*:(.*)$", text, re.M)
+    return set(line.group(1).split()) if line else set()
+
+
+def test_vector_width_is_the_processors():
+    flags = _cpu_flags()
+    if not flags:
+        pytest.skip("no /proc/cpuinfo flags to compare with")
+    expected = 8 if "avx512f" in flags else 4 if "avx" in flags else 2
+    assert vector_doubles() == expected
+    assert default_lanes() == min(expected, LANES)
+
+
+def _vector_symbols(library: Path) -> set[str]:
+    listing = subprocess.run(["nm", "-D", "--undefined-only", str(library)], capture_output=True, text=True)
+    return {name for name in re.findall(r"\b(_ZGV\w+)", listing.stdout)}
+
+
+@pytest.mark.skipif(shutil.which("nm") is None, reason="no nm (binutils) to list the library's symbols")
+@pytest.mark.parametrize("lanes", [4, 8])
+def test_the_lanes_call_libmvec_vector_functions_of_their_width(lanes):
+    """Vector-ABI names (_ZGV<isa><mask><lanes>...): 'e' is AVX-512, 'd' AVX2, 'c' AVX, 'b' SSE."""
+    if vector_doubles() < 4:
+        pytest.skip("this processor has no 256-bit vectors")
+    symbols = _vector_symbols(compile_lanes(_step(), lanes).library)
+    # 8 lanes on AVX-512 fill one 512-bit register; otherwise 256-bit (AVX2) vectors of 4
+    isa, width = ("e", 8) if vector_doubles() == 8 and lanes == 8 else ("d", 4)
+    expected = {f"_ZGV{isa}N{width}v_sin", f"_ZGV{isa}N{width}v_cos", f"_ZGV{isa}N{width}v_exp",
+                f"_ZGV{isa}N{width}vv_atan2"}
+    assert expected <= symbols, symbols
+
+
+@pytest.mark.parametrize("lanes", [1, 4, 8])
+def test_each_lane_equals_the_scalar_roll(lanes):
+    """Lanes that start apart stay equal to the scalar roll of each (libmvec within a few ulp of libm)."""
+    step, N = _step(), 500
+    rng = np.random.default_rng(lanes)
+    z0 = rng.uniform(-1.0, 1.0, (2, lanes))
+    W = rng.uniform(-2.0, 2.0, (N, 2, lanes))
+    out = np.empty((N, 2, lanes))
+    z_end = compile_lanes(step, lanes)(np.ascontiguousarray(z0), np.ascontiguousarray(W), out)
+    scalar = compile_roll(step)
+    for lane in range(lanes):
+        own = np.empty((N, 2))
+        z_lane = scalar(z0[:, lane], np.ascontiguousarray(W[:, :, lane]), own)
+        np.testing.assert_allclose(out[:, :, lane], own, rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(z_end[:, lane], z_lane, rtol=1e-12, atol=1e-14)
+    assert not np.allclose(out[:, :, 0], out[:, :, -1]) or lanes == 1  # the lanes ran apart
