@@ -1,6 +1,7 @@
 """Unit checks of the C package writer: the unused-parameter marks on CasADi's code, the header's guard,
 description and citation, the return codes a wrapper documents, the manifest's arguments, digests and stale
-files. Expected texts are written out by hand from the module docstring and C's rules."""
+files, the float build's literals and math calls. Expected texts are written out by hand from the module
+docstring and C's rules."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 from uvsym.codegen import find_compiler
 from uvsym.codegen.arguments import Entries
 from uvsym.codegen.example import Example
-from uvsym.codegen.package import Exported, _silence_unused, write_package
+from uvsym.codegen.package import Exported, _silence_unused, _single_precision, write_package
 from uvsym.errors import CodegenError
 
 
@@ -71,6 +72,42 @@ def test_a_marked_function_compiles_with_unused_parameter_warnings_as_errors(tmp
         done = subprocess.run([*flags, str(tmp_path / "f.c")], capture_output=True, text=True)
         assert (done.returncode == 0) == compiles, done.stderr
         assert compiles or "unused parameter" in done.stderr
+
+
+# --- _single_precision -----------------------------------------------------------------------------------------
+
+
+def test_float_literals_get_their_suffix_and_out_of_range_ones_the_nearest_float_bound():
+    source = ("a1=2.; a2=8.3333333333333329e-02; a3=-1.0000000000000001e+300; a4=1.0000000000000000e-300; "
+              "a5=0.; a6=(2.*a5); a7=1e5;")
+    assert _single_precision(source) == ("a1=2.f; a2=8.3333333333333329e-02f; a3=-3.40282347e+38f; "
+                                         "a4=1.17549435e-38f; a5=0.f; a6=(2.f*a5); a7=1e5f;")
+
+
+def test_math_calls_become_their_float_twins_and_nothing_else_is_renamed():
+    source = "/* CasADi 3.8.2. */ x=sqrt(a)+exp (b)+atan2(a,b); y=casadi_fmax(a,b); z=fmax(a,b); w=my_sin(a); v=a12;"
+    assert _single_precision(source) == ("/* CasADi 3.8.2. */ x=sqrtf(a)+expf (b)+atan2f(a,b); y=casadi_fmax(a,b); "
+                                         "z=fmaxf(a,b); w=my_sin(a); v=a12;")
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler (set $CC or install gcc)")
+def test_a_float_package_keeps_a_guard_against_zero_that_float_cannot_hold(tmp_path):
+    """y = sqrt(x) / max(x, 1e-300): 0 at x = 0 in double; 1e-300 is 0 in float (0/0 = NaN) unless it
+    becomes float's smallest normal number."""
+    x = ca.SX.sym("x")
+    function = ca.Function("guarded", [x], [ca.sqrt(x) / ca.fmax(x, 1e-300)], ["x"], ["y"])
+    write_package(tmp_path, [Exported(function, ("x (-)",), ("y (-)",), "guarded")], "tiny", "float",
+                  finite_check=False)
+    assert "sqrtf(" in (tmp_path / "src" / "tiny_casadi.c").read_text()
+    (tmp_path / "main.c").write_text('#include <stdio.h>\n#include "tiny.h"\nint main(void) {\n'
+                                     '  tiny_real x[1] = {0.0f}, y[1];\n  int rc = tiny_guarded(x, y);\n'
+                                     '  printf("%d %g\\n", rc, (double)y[0]);\n  return 0;\n}\n')
+    exe = tmp_path / "main"
+    done = subprocess.run([find_compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-I",
+                           str(tmp_path / "include"), str(tmp_path / "main.c"), str(tmp_path / "src" / "tiny_casadi.c"),
+                           str(tmp_path / "src" / "tiny.c"), "-o", str(exe), "-lm"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert subprocess.run([str(exe)], capture_output=True, text=True).stdout.split() == ["0", "0"]
 
 
 # --- header -----------------------------------------------------------------------------------------------------

@@ -32,7 +32,9 @@ the wrappers are not reentrant. With ``finite_check`` (the default) a wrapper re
 returns ``<NAME>_UNHEALTHY`` when it is not positive, the case in which the Python run raises
 CovarianceError. The same functions and options give byte-identical files.
 A double build matches the Python evaluation to 1e-12 relative; a float build (C only: it
-cannot be loaded through casadi.external) to 1e-5 of each call's largest output (tested).
+cannot be loaded through casadi.external) to 1e-5 of each call's largest output (tested). A float
+build computes in float throughout: CasADi's double literals and math calls are rewritten
+(:func:`_single_precision`), so that a single-precision FPU runs it without soft-float double.
 """
 
 from __future__ import annotations
@@ -114,6 +116,30 @@ def _silence_unused(source: str) -> str:
         return match.group(1) + ("\n  " + " ".join(f"(void){n};" for n in unused) if unused else "")
 
     return pattern.sub(mark, source)
+
+
+# C99 <math.h> functions of double whose float twin is the name with an f (sqrt -> sqrtf)
+MATH_FUNCTIONS = ("acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cbrt", "ceil", "copysign", "cos",
+                  "cosh", "erf", "erfc", "exp", "exp2", "expm1", "fabs", "fdim", "floor", "fma", "fmax", "fmin", "fmod",
+                  "hypot", "log", "log10", "log1p", "log2", "pow", "remainder", "round", "sin", "sinh", "sqrt", "tan",
+                  "tanh", "tgamma", "trunc")
+FLOAT_MAX, FLOAT_MIN = "3.40282347e+38f", "1.17549435e-38f"  # float's largest finite and smallest normal magnitudes
+_LITERAL = re.compile(r"(?<![\w.])(\d+\.\d*(?:[eE][-+]?\d+)?|\d+[eE][-+]?\d+)(?![\w.])")
+_MATH_CALL = re.compile(r"(?<![\w.])(" + "|".join(MATH_FUNCTIONS) + r")(?=\s*\()")
+
+
+def _single_precision(source: str) -> str:
+    """CasADi's source for ``casadi_real`` float computed in float: every floating literal gets the
+    suffix f (a magnitude beyond float's normal range becomes the nearest of FLOAT_MAX and FLOAT_MIN,
+    so a bound stays finite and a guard against zero stays positive) and every math call its float
+    twin (``sqrtf``), where CasADi writes double ones (soft-float double on a single-precision FPU)."""
+    def literal(match: re.Match) -> str:
+        magnitude = float(match.group(1))
+        if magnitude > float(FLOAT_MAX[:-1]):
+            return FLOAT_MAX
+        return FLOAT_MIN if 0.0 < magnitude < float(FLOAT_MIN[:-1]) else match.group(1) + "f"
+
+    return _MATH_CALL.sub(r"\1f", _LITERAL.sub(literal, source))
 
 
 def _c_name(name: str) -> str:
@@ -248,6 +274,7 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
         source = _silence_unused((Path(scratch) / f"{name}_casadi.c").read_text())
         header = (Path(scratch) / f"{name}_casadi.h").read_text()
     wrappers = [_wrapper(e, name, finite_check) for e in functions]
+        source = _single_precision(source) if precision == "float" else source
     checked = finite_check and any(d for e in functions for _, _, d, _ in e.arguments())  # an entry to check
     all_finite = _ALL_FINITE.format(package=name) + "\n" if checked else ""
     includes = f'#include <math.h>\n#include "{name}_casadi.h"\n#include "{name}.h"\n\n'
