@@ -272,9 +272,9 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
     with tempfile.TemporaryDirectory() as scratch:
         generator.generate(f"{scratch}{os.sep}")
         source = _silence_unused((Path(scratch) / f"{name}_casadi.c").read_text())
+        source = _single_precision(source) if precision == "float" else source
         header = (Path(scratch) / f"{name}_casadi.h").read_text()
     wrappers = [_wrapper(e, name, finite_check) for e in functions]
-        source = _single_precision(source) if precision == "float" else source
     checked = finite_check and any(d for e in functions for _, _, d, _ in e.arguments())  # an entry to check
     all_finite = _ALL_FINITE.format(package=name) + "\n" if checked else ""
     includes = f'#include <math.h>\n#include "{name}_casadi.h"\n#include "{name}.h"\n\n'
