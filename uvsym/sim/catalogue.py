@@ -160,6 +160,13 @@ def schedule(fields: Fields, plant: System, name: str, publishes: tuple[str, ...
     values = fields.raw("values", None, "list of rows", "one row (or number) per time")
     if times is None or values is None:
         raise ScenarioError(f"{fields.path}: a time table needs times and values")
+    for key, table in (("times", times), ("values", values)):
+        try:
+            finite = np.all(np.isfinite(np.asarray(table, dtype=float)))
+        except (TypeError, ValueError):
+            finite = False
+        if not finite:
+            raise ScenarioError(f"{fields._name(key)}: expected finite numbers, got {table!r}")
     return open_loop(name, times, values, _group(plant, publishes, fields.path, "published"),
                      fields.text("interpolation", "previous", choices=INTERPOLATIONS))
 

@@ -150,8 +150,12 @@ def open_loop(name: str, t_table, u_table, publishes: Sequence[str] | Signals,
         raise ModelError(f"open loop {name}: unknown interpolation {interpolation!r}; known: "
                          f"{', '.join(INTERPOLATIONS)}")
     publishes = as_signals(publishes, "published")
-    times = np.asarray(t_table, dtype=float).reshape(-1)
-    values = np.asarray(u_table, dtype=float)
+    try:
+        times = np.asarray(t_table, dtype=float).reshape(-1)
+        values = np.asarray(u_table, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"open loop {name}: times and values must be numbers, got {t_table!r} and {u_table!r}") \
+            from None
     if times.size == 0 or values.size != times.size * publishes.size:
         raise ModelError(f"open loop {name}: needs one row of {publishes.size} value(s) per time; got {times.size} "
                          f"times and a table of shape {values.shape}")

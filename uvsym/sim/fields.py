@@ -94,6 +94,15 @@ class Fields:
                                 + (f" (did you mean {near[0]!r}?)" if near else "") + f"; known: {', '.join(choices)}")
         return value
 
+    def label(self, key: str, default=None, *, spaces: bool = False) -> str:
+        """A name: a non-empty string, without white space unless ``spaces`` (a scenario's name may have
+        them; a detector's names result columns)."""
+        value = self.text(key, default)
+        if not value.strip() or (not spaces and any(c.isspace() for c in value)):
+            rule = "a non-empty string" + ("" if spaces else " without white space")
+            raise ScenarioError(f"{self._name(key)}: a name must be {rule}, got {value!r}")
+        return value
+
     def vector(self, key: str, size: int, default=None) -> np.ndarray | None:
         self._record(key, "list of numbers", default, "finite, one per entry", None if default is not None else "none")
         self.used.add(key)

@@ -13,7 +13,6 @@ import re
 import tomllib
 from copy import deepcopy
 from dataclasses import dataclass, replace
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +37,7 @@ from uvsym.observers.gains import design_gains
 from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
 from uvsym.sim.fields import Fields as _Fields  # also imported under this name by derivations
 from uvsym.sim.run import MAX_SAMPLES, check_memory
+from uvsym.sim.shipped import shipped_scenarios
 
 __all__ = ["Scenario", "ObserverSpec", "load_scenario", "parse_scenario", "read_scenario_file",
            "shipped_scenarios"]
@@ -79,22 +79,6 @@ class Scenario:
     observers: tuple[ObserverSpec, ...]
     current_variation: tuple[float, float] = (0.0, 10.0)
     diagnosis: DiagnosisSettings | None = None
-
-
-def shipped_scenarios(kind: str = "vehicle") -> dict[str, Path]:
-    """Example scenarios shipped with uvsym: name -> path; ``kind`` "vehicle" (``scenarios/``) or
-    "plant" (scenarios over a registered plant, ``scenarios/plants/``)."""
-    folder = resources.files("uvsym.sim") / "scenarios"
-    folder = folder / "plants" if kind == "plant" else folder
-    return {Path(str(p)).stem: Path(str(p)) for p in sorted(folder.iterdir(), key=str) if str(p).endswith(".toml")}
-
-
-def every_shipped_scenario() -> dict[str, Path]:
-    """Every scenario shipped by uvsym (vehicles, plants) and by the installed derivations: name -> path."""
-    from uvsym.derivation import study_scenarios
-
-    return {**shipped_scenarios(), **shipped_scenarios("plant"),
-            **{name: file for name, (_, file) in study_scenarios().items()}}
 
 
 def read_scenario_file(path) -> dict:
@@ -152,7 +136,7 @@ def parse_scenario(data: dict, default_name: str = "scenario", schema: dict | No
     (:func:`scenario_schema`)."""
     top = _Fields(data, "", schema)
     top.describe("name", "string", "", "the file's name")
-    name = top.text("name", default_name)
+    name = top.label("name", default_name, spaces=True)
     description = top.text("description", "")
     if "vehicle" not in data:
         near = difflib.get_close_matches("plant", [str(k) for k in data], n=1, cutoff=0.7)

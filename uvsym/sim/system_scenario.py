@@ -78,6 +78,7 @@ import numpy as np
 from uvsym.codegen.cache import memoized
 from uvsym.diagnosis.detectors import DoubleCriterion, EstimatedFault, ResidualThreshold, StepDecision
 from uvsym.errors import ScenarioError, UvsymError
+from uvsym.errors import did_you_mean as _close
 from uvsym.faults import ActuatorFault, SensorFault
 from uvsym.sim.blocks import Block
 from uvsym.sim.catalogue import _names, build_block, schedule
@@ -163,11 +164,6 @@ class DisturbanceNoise:
         if self.std.any():
             out += self.std * rng.standard_normal(shape)
         return out
-
-
-def _close(name: str, known) -> str:
-    near = difflib.get_close_matches(name, list(known), n=1)
-    return f" (did you mean {near[0]!r}?)" if near else ""
 
 
 def _plant(top: Fields, root: Path) -> System:
@@ -281,12 +277,14 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
     for fields in items:
         fields.describe("signal", "string", "one of the plant's disturbances")
         signal = fields.text("signal", choices=plant.d.names)
-        times = fields.vector("times", len(fields.data.get("times") or []))
-        values = fields.vector("values", times.size if times is not None else 0)
+        given = fields.data.get("times")
+        times = fields.vector("times", len(given) if isinstance(given, list) else -1)
+        if times is None or not times.size or np.any(np.diff(times) <= 0):
+            raise ScenarioError(f"{fields.path}.times: expected strictly increasing times (s), one per value, "
+                                f"got {given!r}")
+        values = fields.vector("values", times.size)
         how = fields.text("interpolation", "previous", choices=INTERPOLATIONS)
         fields.done()
-        if times is None or not times.size or np.any(np.diff(times) <= 0):
-            raise ScenarioError(f"{fields.path}.times: expected strictly increasing times (s), one per value")
         schedule_step = open_loop(f"disturbance_{signal}", times, values, (signal,), how).step  # a set-point's rule
         table[:, plant.d.index(signal)] = np.asarray(schedule_step.map(N + 1)(np.zeros((0, N + 1)), t[None, :])[1])
     return table
@@ -483,7 +481,7 @@ def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.n
     if fields.schema is not None:  # recording the schema: each type's fields under detectors[<type>]
         fields = Fields(fields.data, f"detectors[{kind}]", fields.schema)
         fields.used.add("type")
-    name = fields.text("name", kind)
+    name = fields.label("name", kind)
     try:
         detector = DETECTORS[kind](fields, name, scenario_loop, z0, w0, step)
     except ScenarioError:
@@ -502,7 +500,7 @@ def parse_system_scenario(data: dict, default_name: str = "scenario", root=".",
     top.describe("name", "string", "the run's name in results and logs", "the file's name")
     top.describe("plant_path", "string", "folder a module:function plant is imported from",
                  "the scenario file's folder")
-    name, description = top.text("name", default_name), top.text("description", "")
+    name, description = top.label("name", default_name, spaces=True), top.text("description", "")
     plant = _plant(top, Path(root))
     duration, step = top.number("duration", positive=True), top.number("step", positive=True)
     if abs(round(duration / step) * step - duration) > 1e-9 * duration:
