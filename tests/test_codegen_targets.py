@@ -44,13 +44,9 @@ def built(tmp_path_factory):
     return build
 
 
-def _harness_rows(out, target: str, precision: str) -> dict[int, np.ndarray]:
-    """The package's own `make run-target` (built with -Werror): outputs per function index, decoded from bits."""
-    flags = " ".join([STRICT, *TARGETS[target].flags])
-    done = subprocess.run(["make", "-s", "-C", str(out), "run-target", f"TARGET_CFLAGS={flags}"], capture_output=True,
-                          text=True, timeout=900)
-    assert done.returncode == 0, done.stderr[-3000:]
-    lines = (done.stdout + done.stderr).split("\n")
+def _harness_rows(printed: str, precision: str) -> dict[int, np.ndarray]:
+    """A harness's printed lines: outputs per function index, decoded from their bits."""
+    lines = printed.split("\n")
     assert "end" in lines
     code, width = ("<d", 8) if precision == "double" else ("<f", 4)
     rows: dict[int, list] = {}
@@ -62,17 +58,11 @@ def _harness_rows(out, target: str, precision: str) -> dict[int, np.ndarray]:
     return {k: np.array(v) for k, v in rows.items()}
 
 
-UNCHECKED = {("usv-fukf-mmae", "float"): "the set has no example data, and its seeded random vectors are no "
-                                          "filter states: the float build's factorisations fail on them (NaN)"}
-
-
 @pytest.mark.parametrize("target,precision", BUILDS)
 @pytest.mark.parametrize("name", SETS)
 def test_the_package_runs_on_the_target_as_python_computes(built, name, target, precision):
-    if (name, precision) in UNCHECKED:
-        pytest.xfail(UNCHECKED[name, precision])
     made, out, manifest = built(name, target, precision)
-    got = _harness_rows(out, target, precision)
+    got = _harness_rows((out / "target" / "harness.out").read_text(), precision)
     vectors = target_vectors(list(made.exported), made.example)
     for k, (e, v) in enumerate(zip(made.exported, vectors)):
         expected = evaluate_rows(e.function, v)
@@ -85,7 +75,10 @@ def test_the_package_runs_on_the_target_as_python_computes(built, name, target, 
     figures = manifest["target"]
     assert figures["flash"] > 0 and figures["ram"] > 0
     assert not set(figures["library_symbols"]) & set(FORBIDDEN)
-    assert figures["cppcheck"] is None or figures["cppcheck"]["findings"] == [], figures["cppcheck"]
+    check = figures["cppcheck"]
+    assert check is None or check["timed_out_s"] or check["findings"] == [], check
+    if check is not None and not check["timed_out_s"]:  # the wrappers return early: MISRA C:2012 rule 15.5
+        assert check["misra"]["rules"]["15.5"] > 0 and "MISRA C:2012 addon" in (out / "README.md").read_text()
     for function in figures["functions"].values():
         assert function["stack_bound"] is not None and function["stack_measured"] > 0
         assert function["instructions"] > 0
@@ -93,20 +86,42 @@ def test_the_package_runs_on_the_target_as_python_computes(built, name, target, 
     assert f"## Target: {target}" in text and f"-mcpu={TARGETS[target].flags[0].split('=')[1]}" in text
 
 
-def test_issue_targets_stack_and_cost_of_the_actuator_and_lms_steps(built):
-    """Within 5 kB of stack and 50,000 instructions per call on an M4F in float (the UKF bank's 1 ms at
-    168 MHz is a figure of benchmarks/targets.py: missed, the float build calls double libm)."""
+def test_issue_targets_stack_and_cost_of_the_actuator_lms_and_ukf_bank_steps(built):
+    """The actuator-observer and LMS steps within 5 kB of stack and 50,000 instructions per call on an M4F
+    in float; the UKF bank's step within 1 ms: 168,000 instructions at 168 MHz on an M4F in float,
+    600,000 at 600 MHz on an M7 in double (one instruction per cycle)."""
     for name, function in (("actuator-observers", "actuator_observers_step"), ("sensor-fdi-lms", None)):
         figures = built(name, "cortex-m4f", "float")[2]["target"]
         steps = [f for n, f in figures["functions"].items() if function is None or n == function]
         assert steps and all(max(f["stack_bound"], f["stack_measured"]) <= 5120 for f in steps)
         assert all(f["instructions"] <= 50000 for f in steps), [f["instructions"] for f in steps]
+    for target, precision, most in (("cortex-m4f", "float", 168000), ("cortex-m7", "double", 600000)):
+        figures = built("usv-fukf-mmae", target, precision)[2]["target"]
+        assert figures["functions"]["ukf_step"]["instructions"] <= most, (target, figures["functions"])
+
+
+def test_a_float_build_calls_float_math_only(built):
+    """No double arithmetic or double libm in an M4F float build: CasADi writes sqrt, sin, 2.*x."""
+    symbols = built("usv-fukf-mmae", "cortex-m4f", "float")[2]["target"]["library_symbols"]
+    assert "sqrtf" in symbols and "sinf" in symbols
+    assert not [s for s in symbols if s.startswith("__aeabi_d") or s in ("sqrt", "sin", "cos", "exp", "log")], symbols
 
 
 def test_figures_are_reproducible_to_the_instruction(built, tmp_path):
     made, _, manifest = built("motor-luenberger", "cortex-m4f", "float")
     again = made.write(tmp_path, "float", target="cortex-m4f")["target"]
     assert again["functions"] == manifest["target"]["functions"] and again["flash"] == manifest["target"]["flash"]
+
+
+@pytest.mark.parametrize("target,precision", (("cortex-m4f", "float"), ("cortex-m7", "double")))
+def test_make_run_target_prints_what_the_package_recorded(built, target, precision):
+    """The package's own `make run-target`, built with -Werror -pedantic, prints target/harness.out to the tick."""
+    _, out, _ = built("sensor-fdi-lms", target, precision)
+    flags = " ".join([STRICT, *TARGETS[target].flags])
+    done = subprocess.run(["make", "-s", "-C", str(out), "run-target", f"TARGET_CFLAGS={flags}"], capture_output=True,
+                          text=True, timeout=900)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert done.stdout + done.stderr == (out / "target" / "harness.out").read_text()
 
 
 def test_a_budget_names_the_figure_it_refuses(built, tmp_path):

@@ -58,7 +58,8 @@ class ObserverSet:
 
         target: a name of :data:`uvsym.codegen.targets.TARGETS`; the package is first built and run
         for it in a scratch folder (:func:`uvsym.codegen.target_run.run_target`), its figures and
-        its distance from Python go into the manifest (``target``) and README, and a figure beyond
+        its distance from Python go into the manifest (``target``) and README, what its harness printed
+        into ``target/harness.out``, and a figure beyond
         ``budget`` (flash, ram, stack, instructions) refuses the package with BudgetError.
         """
         extra = {}
@@ -72,16 +73,17 @@ class ObserverSet:
                     raise CodegenError(f"observer set {self.package_name}: its example calls {self.example.function}, "
                                        f"which it does not export")
                 extra["float_check"] = checked_float(exported, self.example, float_tolerance).to_dict(float_tolerance)
-        chosen = None
+        chosen = printed = None
         if target is not None:
             chosen = targets.target(target)
-            extra["target"] = self._measure_target(chosen, precision, finite_check, budget or {})
+            extra["target"], printed = self._measure_target(chosen, precision, finite_check, budget or {})
         return write_package(out_dir, list(self.exported), self.package_name, precision, self.description,
                              citation=self.citation, example=self.example, finite_check=finite_check, extra=extra,
-                             target=chosen)
+                             target=chosen, target_output=printed)
 
-    def _measure_target(self, chosen, precision: str, finite_check: bool, budget: dict[str, int]) -> dict:
-        """The target figures of this set's package (``write``), checked against ``budget``."""
+    def _measure_target(self, chosen, precision: str, finite_check: bool, budget: dict[str, int]) -> tuple[dict, str]:
+        """The target figures of this set's package (``write``), checked against ``budget``, and what its
+        harness printed."""
         from uvsym.codegen.target_run import check_budget, differences, run_target
 
         with tempfile.TemporaryDirectory(prefix="uvsym-target-") as scratch:
@@ -96,7 +98,7 @@ class ObserverSet:
         figures["difference_unit"] = ("ulp (2^-52) of each output's scale max(1, max|Python|)" if precision == "double"
                                       else "relative to each output's scale max(1, max|Python|)")
         check_budget(figures, budget)
-        return figures
+        return figures, run.printed
 
 
 def options_of(factory: Callable[..., ObserverSet]) -> tuple[str, ...]:

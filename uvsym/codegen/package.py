@@ -243,14 +243,16 @@ def _argument_entry(name: str, size: int, doc) -> dict:
 
 def write_package(out_dir, functions: list[Exported], name: str, precision: str = "double",
                   description: str = "", *, citation: str = "", example: Example | None = None,
-                  finite_check: bool = True, extra: dict | None = None, target=None) -> dict:
+                  finite_check: bool = True, extra: dict | None = None, target=None,
+                  target_output: str | None = None) -> dict:
     """Write the package (module docstring) into ``out_dir``; returns the manifest.
 
     citation: the reference of the method implemented (header, README, manifest); example: data
     for ``main.c`` (:class:`~uvsym.codegen.example.Example`), else it calls on zeros;
     finite_check: wrappers check inputs and outputs for NaN and infinity; extra: more manifest keys;
     target: a :class:`~uvsym.codegen.targets.Target` whose build files and harness go into ``target/``
-    (:func:`uvsym.codegen.targets.target_files`).
+    (:func:`uvsym.codegen.targets.target_files`); target_output: what its harness printed when built
+    and run for it (``target/harness.out``).
     """
     if precision not in PRECISIONS:
         raise CodegenError(f"unknown precision {precision!r}; known: {', '.join(PRECISIONS)}")
@@ -287,6 +289,8 @@ def write_package(out_dir, functions: list[Exported], name: str, precision: str 
         from uvsym.codegen.targets import target_files, target_vectors
 
         texts |= target_files(functions, name, precision, target, target_vectors(functions, example))
+        if target_output is not None:
+            texts["target/harness.out"] = target_output
     manifest = {
         "package": name, "description": description, "citation": citation, "precision": precision,
         "casadi": ca.__version__, "finite_check": finite_check,

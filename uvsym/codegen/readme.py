@@ -58,14 +58,15 @@ def _target_section(manifest: dict) -> str:
                 f"{check['version']} (default checks) stopped after {check['timed_out_s']} s: not analysed."
                 if check.get("timed_out_s") else
                 f"{check['version']} (default checks): {len(check['findings'])} findings"
-                + "".join(f"\n- {line}" for line in check["findings"][:20]))
+                + "".join(f"\n- {line}" for line in check["findings"][:20]) + _misra(check["misra"]))
     return f"""
 ## Target: {figures['target']}
 
 {figures['description']}. {build}; `cmake -DCMAKE_TOOLCHAIN_FILE=target/toolchain.cmake` uses the
 same compiler and flags: `{' '.join(figures['flags'])}`. The harness (`target/harness.c`, with
 `target/board.c`: startup, semihosting output, no heap) calls every function on its test vectors
-and prints each output's bits. Measured when this package was written ({figures['compiler']}):
+and prints each output's bits; `target/harness.out` is what it printed when this package was
+written (`make run-target` prints the same on the same toolchain). Measured then ({figures['compiler']}):
 flash {figures['flash']} bytes (text, rodata and data of the package's objects), RAM {figures['ram']}
 bytes (data and bss: the static work arrays). Stack: the bound of the package's own code from
 `-fstack-usage` and the call graph, and the high-water mark measured under qemu (with the C
@@ -78,6 +79,15 @@ library's frames); instructions per call: the largest over the vectors, counted 
 
 C library symbols the package needs: {libraries}. {cppcheck}
 """
+
+
+def _misra(misra: dict) -> str:
+    """The README's line on cppcheck's MISRA C:2012 addon (its findings per rule, or why it did not run)."""
+    if "error" in misra:
+        return f"\n\nIts MISRA C:2012 addon did not run: {misra['error']}"
+    rules = ", ".join(f"{rule}: {count}" for rule, count in misra["rules"].items())
+    return (f"\n\nIts MISRA C:2012 addon (rule numbers only: cppcheck ships without the rules' texts): "
+            f"{misra['findings']} findings" + (f" (per rule: {rules})." if rules else "."))
 
 
 def package_readme(manifest: dict) -> str:

@@ -15,7 +15,9 @@ that target (:mod:`uvsym.codegen.targets`) with ``-Wall -Wextra -Werror``, then 
   call and calibrates ticks per instruction on a loop of known length (bare metal only);
 - the C library symbols the package objects need (``nm -u``), refused when one allocates or
   does I/O (``FORBIDDEN``), and the findings of ``cppcheck`` (default checks, one preprocessor
-  configuration; its information messages left out; stopped after ``CPPCHECK_SECONDS``) when installed;
+  configuration; its information messages left out; stopped after ``CPPCHECK_SECONDS``) when installed,
+  with the count per rule of its MISRA C:2012 addon's findings (rule numbers only: the addon ships
+  without the rules' texts), or the reason the addon did not run;
 - each call's outputs, decoded from their bits, with their return codes, and how far they are
   from CasADi's evaluation of the same vectors (:func:`differences`): a double build in units
   of the last place (2^-52) of each output's scale ``max(1, max|Python|)``, a float build relative
@@ -31,6 +33,7 @@ import re
 import shutil
 import struct
 import subprocess
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,7 +48,7 @@ __all__ = ["BUDGET_KEYS", "FORBIDDEN", "BudgetError", "TargetRun", "check_budget
 FORBIDDEN = ("malloc", "calloc", "realloc", "free", "_sbrk", "sbrk", "printf", "fprintf", "sprintf", "snprintf",
              "vprintf", "puts", "fputs", "putchar", "fopen", "fwrite", "fread", "write", "_write", "scanf")
 BUDGET_KEYS = ("flash", "ram", "stack", "instructions")
-CPPCHECK_SECONDS = 60  # cppcheck's time limit per package (its result then says it timed out)
+CPPCHECK_SECONDS = 30  # cppcheck's time limit per package (its result then says it timed out)
 
 
 class BudgetError(CodegenError):
@@ -55,11 +58,13 @@ class BudgetError(CodegenError):
 @dataclass(frozen=True)
 class TargetRun:
     """figures: what goes into the manifest (module docstring); outputs: per function, a (rows, outputs)
-    array of the harness's results; codes: per function, the return code of each row."""
+    array of the harness's results; codes: per function, the return code of each row; printed: the
+    harness's output, line by line (``target/harness.out`` of the package)."""
 
     figures: dict
     outputs: dict[str, np.ndarray]
     codes: dict[str, np.ndarray]
+    printed: str
 
 
 def _tools(chosen: Target) -> dict[str, str]:
@@ -154,14 +159,24 @@ def _cppcheck(package_dir: Path, name: str) -> dict | None:
 def _run_cppcheck(package_dir: Path, sources: list[str]) -> dict:
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
     try:
-        done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1",
+        done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1", "--addon=misra",
                                "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
                                *sources], cwd=package_dir,
                               capture_output=True, text=True, timeout=CPPCHECK_SECONDS)
     except subprocess.TimeoutExpired:  # its value-flow analysis of a large generated source can take many minutes
-        return {"version": version, "findings": [], "timed_out_s": CPPCHECK_SECONDS}
-    findings = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: (?!information)\w+: ", line)]
-    return {"version": version, "findings": findings, "timed_out_s": None}
+        return {"version": version, "findings": [], "misra": None, "timed_out_s": CPPCHECK_SECONDS}
+    lines = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: (?!information)\w+: ", line)]
+    rules = Counter(m.group(1) for m in (re.search(r"\[misra-c2012-([\d.]+)\]$", line) for line in lines) if m)
+    failed = re.search(r"Failed to execute [^\n]*", done.stderr)
+    misra = ({"error": failed.group(0)} if failed else
+             {"findings": sum(rules.values()), "rules": dict(sorted(rules.items(), key=lambda r: _rule_key(r[0])))})
+    return {"version": version, "findings": [line for line in lines if "[misra-" not in line], "misra": misra,
+            "timed_out_s": None}
+
+
+def _rule_key(rule: str) -> tuple[int, ...]:
+    """"10.3" -> (10, 3): MISRA rules in their document's order."""
+    return tuple(int(part) for part in rule.split("."))
 
 
 def _decode(hexes: list[str], precision: str) -> np.ndarray:
@@ -229,7 +244,7 @@ def run_target(package_dir, functions, name: str, precision: str, chosen: Target
                "precision": precision, "flash": flash, "ram": ram, "library_symbols": needed,
                "functions": described, "cppcheck": _cppcheck(package_dir, name)}
     shutil.rmtree(build, ignore_errors=True)
-    return TargetRun(figures, outputs, codes)
+    return TargetRun(figures, outputs, codes, "\n".join(lines) + "\n")
 
 
 def differences(functions, vectors, run: TargetRun, precision: str) -> dict[str, float]:

@@ -12,6 +12,9 @@ gives what a package built for a target holds besides its sources, under ``targe
                        function; per call it prints the return code, timer ticks, the stack
                        high-water and each output's bits in hexadecimal (exact)
     toolchain.cmake    a CMake toolchain file with the same compiler and flags
+    harness.out        what the harness printed when uvsym built and ran it (written by
+                       :meth:`~uvsym.codegen.observer_sets.ObserverSet.write`): ``make run-target``
+                       prints the same, to the instruction, on the same toolchain
 
 Nothing is allocated: the harness, like the package, uses static storage only, and prints
 through semihosting (``SYS_WRITE0``), not libc I/O.
