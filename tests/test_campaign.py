@@ -495,7 +495,8 @@ def test_a_study_scenario_is_found_by_name(tmp_path):
     text = 'name = "s"\n[[case]]\nname = "a"\nscenario = "compass_10deg"\n[case.grid]\nseed = [1, 2]\n'
     campaign = load_campaign(_write(tmp_path, text))
     assert [r.scenario["plant"] for r in campaign.runs] == ["rov_yaw", "rov_yaw"]
-    with pytest.raises(CampaignError, match=r"no shipped scenario 'compass_11deg'; shipped: .*compass_10deg"):
+    with pytest.raises(CampaignError, match=r"no shipped scenario 'compass_11deg' \(did you mean 'compass_10deg'"
+                                            r"\?\); shipped: .*compass_10deg"):
         load_campaign(_write(tmp_path, text.replace("compass_10deg", "compass_11deg")))
 
 

@@ -218,15 +218,43 @@ def test_unknown_observer_sets_and_options_are_refused_by_name():
         observer_set("actuator-observers", colour="red")
 
 
+def _toy_package(monkeypatch, tmp_path, declared: str = "{p.stem: p for p in SCENARIOS.glob('*.toml')}"):
+    """A derivation ``toy`` as a package on disk (``toy_study``) shipping ``scenarios/toy_run.toml`` and declaring
+    the scenarios ``declared`` (Python source), installed as the only derivation."""
+    from importlib.metadata import EntryPoint
+
+    import uvsym.derivation
+
+    package = tmp_path / "toy_study"
+    (package / "scenarios").mkdir(parents=True)
+    (package / "scenarios" / "toy_run.toml").write_text(
+        'plant = "rov_yaw"\nduration = 2.0\nstep = 0.1\n[[blocks]]\ntype = "open_loop"\n'
+        'name = "thrust"\npublishes = "u"\ntimes = [0.0]\nvalues = [0.1]\n')
+    (package / "__init__.py").write_text(
+        "from pathlib import Path\nfrom uvsym.derivation import Derivation\n"
+        "SCENARIOS = Path(__file__).with_name('scenarios')\n"
+        f"DERIVATION = Derivation('toy', 'Toy', lambda out_dir, progress: None, scenarios={declared})\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "toy_study", raising=False)
+    points = [EntryPoint("toy", "toy_study:DERIVATION", uvsym.derivation.GROUP)]
+    monkeypatch.setattr(uvsym.derivation, "entry_points", lambda group: points)
+    return package
+
+
+def test_a_derivation_declaring_scenarios_outside_its_scenarios_folder_is_refused_by_name(monkeypatch, tmp_path):
+    from uvsym.derivation import DerivationError, derivation, study_scenarios
+
+    package = _toy_package(monkeypatch, tmp_path, declared="{'elsewhere': SCENARIOS.parent / 'elsewhere.toml'}")
+    assert study_scenarios() == {"toy_run": ("toy", package / "scenarios" / "toy_run.toml")}  # nothing imported
+    assert "toy_study" not in sys.modules
+    with pytest.raises(DerivationError, match=r"declares the scenarios \['elsewhere'\], not the files of its "
+                                              r"package's scenarios/ folder \(\['toy_run'\]\)"):
+        derivation("toy")
+
+
 def test_a_derivations_shipped_scenario_runs_by_name_and_an_old_study_file_is_told_what_to_name(
         monkeypatch, tmp_path, capsys):
-    from uvsym.derivation import Derivation
-
-    shipped = tmp_path / "toy_run.toml"
-    shipped.write_text('plant = "rov_yaw"\nduration = 2.0\nstep = 0.1\n[[blocks]]\ntype = "open_loop"\n'
-                       'name = "thrust"\npublishes = "u"\ntimes = [0.0]\nvalues = [0.1]\n')
-    toy = Derivation("toy", "Toy", lambda out_dir, progress: None, scenarios={"toy_run": shipped})
-    _install(monkeypatch, toy=toy)
+    _toy_package(monkeypatch, tmp_path)
     assert main(["simulate", "--list"]) == 0
     assert any(line.split()[:2] == ["toy_run", "toy"] for line in capsys.readouterr().out.splitlines())
     assert main(["simulate", "toy_run", "--out", str(tmp_path / "run.npz")]) == 0

@@ -61,3 +61,34 @@ def test_an_unknown_name_raises_attribute_error_and_a_known_one_is_kept_after_it
     from fake_package import answer
 
     assert answer == 42
+
+
+def test_the_command_line_answers_help_and_misspelt_names_without_the_numerical_libraries_or_a_derivation():
+    """``uvsym --help``, every ``COMMAND --help`` and a misspelt scenario, derivation or file: answered (with the
+    closest name where one is close) before CasADi, scipy, cvxpy, matplotlib, pyarrow or a derivation is imported."""
+    code = (
+        "import contextlib, io, sys\nfrom uvsym.cli import main\n"
+        "calls = [['--help']] + [[c, '--help'] for c in ('models', 'report', 'simulate', 'codegen', 'campaign', "
+        "'verify')] + [['simulate', 'compas_30deg'], ['verify', 'actuator-observer'], ['report', 'nosuch'], "
+        "['codegen', 'nosuch'], ['campaign', 'nosuch.toml'], ['verify', 'sensor-fdi-lms', 'nosuch']]\n"
+        "for call in calls:\n"
+        "    err = io.StringIO()\n"
+        "    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):\n"
+        "        try:\n            status = main(call)\n"
+        "        except SystemExit as stop:\n            status = stop.code\n"
+        "    print(status, err.getvalue().strip().splitlines()[-1] if err.getvalue().strip() else '')\n"
+        "print('loaded:', ' '.join(sorted({m.split('.')[0] for m in sys.modules} & "
+        "{'casadi', 'scipy', 'cvxpy', 'matplotlib', 'pyarrow'}) + [m for m in sys.modules "
+        "if m.startswith('derivations.')]))\n")  # (their package's __init__ is found, not their modules)
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    lines = run.stdout.splitlines()
+    assert lines[-1].split() == ["loaded:"]
+    assert [line.split()[0] for line in lines[:7]] == ["0"] * 7  # the helps
+    simulate, verify, report, codegen, campaign, second = lines[7:13]
+    assert simulate.startswith("2 uvsym: error: no scenario file 'compas_30deg'") and \
+        "(did you mean 'compass_30deg'?)" in simulate
+    assert "unknown derivation 'actuator-observer' (did you mean 'actuator-observers'?)" in verify
+    assert "unknown derivation 'nosuch'; known: actuator-observers" in report
+    assert "give the output folder with -o/--out DIR" in codegen and "cannot be read" in campaign
+    assert "unknown derivation 'nosuch'" in second  # a good name before it is not loaded either

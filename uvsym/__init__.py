@@ -1,27 +1,18 @@
-"""uvsym: marine-vehicle dynamics and fault-diagnosis observers, built symbolically in CasADi."""
+"""uvsym: marine-vehicle dynamics and fault-diagnosis observers, built symbolically in CasADi.
+
+The names below are imported on first use (:mod:`uvsym.lazy`): ``import uvsym.cli`` answers ``--help``
+without CasADi or scipy.
+"""
 
 from uvsym import errors
-from uvsym.models import (
-    Model,
-    fixed_thrusters,
-    identifiability,
-    vectored_thrusters,
-    vehicle,
-    vehicle_names,
-)
-from uvsym.systems import plant, plant_names
+from uvsym.lazy import lazy_exports
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "Model",
-    "__version__",
-    "errors",
-    "fixed_thrusters",
-    "identifiability",
-    "plant",
-    "plant_names",
-    "vectored_thrusters",
-    "vehicle",
-    "vehicle_names",
-]
+_EXPORTS = {  # name -> the submodule that defines it
+    **dict.fromkeys(["Model", "fixed_thrusters", "identifiability", "vectored_thrusters", "vehicle", "vehicle_names"],
+                    "models"),
+    **dict.fromkeys(["plant", "plant_names"], "systems"),
+}
+__all__ = ["__version__", "errors", *_EXPORTS]
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,6 +1,7 @@
 """The ``uvsym`` command: list and inspect vehicles, simulate, and run derivations (report, verify, codegen).
 
-Derivations and their observer sets come through :mod:`uvsym.derivation`.
+Derivations and their observer sets come through :mod:`uvsym.derivation`. Each command imports what it
+runs, and only once its names are checked: ``--help`` and a misspelt name answer without CasADi or scipy.
 """
 
 from __future__ import annotations
@@ -10,22 +11,14 @@ import json
 import os
 import sys
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from uvsym import __version__
-from uvsym.derivation import (
-    Derivation,
-    derivation,
-    load_derivations,
-    observer_set,
-    observer_sets,
-    source_fingerprint,
-)
-from uvsym.errors import UnknownNameError, UvsymError
-from uvsym.models import VEHICLES, vehicle
+from uvsym.errors import UnknownNameError, UvsymError, did_you_mean
 from uvsym.paths import RECORDS, claim_folder, file_hashes, make_folder, output_folder, record_of
-from uvsym.systems.registry import PLANTS, plant, plant_names
+
+if TYPE_CHECKING:
+    from uvsym.derivation import Derivation
 
 __all__ = ["BUILD_STAMP", "main"]
 
@@ -39,6 +32,11 @@ def _table(rows: list[list[str]], header: list[str]) -> str:
 
 
 def _cmd_models(args) -> int:
+    import numpy as np
+
+    from uvsym.models import VEHICLES, vehicle
+    from uvsym.systems.registry import PLANTS, plant, plant_names
+
     if args.action == "show":
         if not args.name:
             raise UnknownNameError(f"'uvsym models show' needs a name; known: {', '.join(plant_names())}")
@@ -110,15 +108,18 @@ def _format_value(value) -> str:
 
 
 def _selected(names: list[str]) -> list[Derivation]:
-    """The derivations named (each checked before any runs), or all installed ones."""
-    return [derivation(name) for name in names] if names else list(load_derivations().values())
+    """The derivations named (each checked before any is loaded), or all installed ones."""
+    from uvsym.derivation import derivations, load_derivations
+
+    return derivations(names) if names else list(load_derivations().values())
 
 
 def _cmd_report(args) -> int:
+    selected = _selected(args.names)
+    from uvsym.derivation import source_fingerprint
     from uvsym.report.figures import figure_style
     from uvsym.report.html import write_html
 
-    selected = _selected(args.names)
     out_root = output_folder(args.out, "reports")
     out_dirs = [claim_folder(out_root / study.name, f"the {study.name} report", "report", args.force,
                              writer=("derivation", study.name), accepts=("verify",))
@@ -144,7 +145,7 @@ def _cmd_report(args) -> int:
 def _scenario_path(source: str) -> Path:
     """A scenario file, or the file of a shipped scenario (uvsym's, found without importing the
     derivations, else a derivation's) named ``source``."""
-    from uvsym.sim.scenario import every_shipped_scenario, shipped_scenarios
+    from uvsym.sim.shipped import every_shipped_scenario, shipped_scenarios
 
     path = Path(source)
     if path.exists():
@@ -154,20 +155,17 @@ def _scenario_path(source: str) -> Path:
         return own[source]
     shipped = every_shipped_scenario()
     if source not in shipped:
-        raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name; "
-                               f"shipped: {', '.join(sorted(shipped))}")
+        raise UnknownNameError(f"no scenario file {source!r} and no shipped scenario of that name"
+                               f"{did_you_mean(source, shipped)}; shipped: {', '.join(sorted(shipped))}")
     return shipped[source]
 
 
 def _cmd_simulate(args) -> int:
-    from uvsym.campaign.metrics import detector_names
     from uvsym.derivation import study_scenarios
-    from uvsym.progress import ProgressBar
-    from uvsym.sim.result import SimResult
-    from uvsym.sim.scenario import read_scenario_file, shipped_scenarios
-    from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
+    from uvsym.sim.shipped import shipped_scenarios
 
     if args.schema is not False:  # the kind named, else the given file's, else the vehicle format
+        from uvsym.sim.scenario import read_scenario_file
         from uvsym.sim.schema import schema_markdown
         from uvsym.sim.system_scenario import is_system_scenario
 
@@ -182,6 +180,12 @@ def _cmd_simulate(args) -> int:
         print(_table(rows, ["shipped scenario", "study", "file"]))
         return 0
     path = _scenario_path(args.scenario)
+    from uvsym.campaign.metrics import detector_names
+    from uvsym.progress import ProgressBar
+    from uvsym.sim.result import SimResult
+    from uvsym.sim.scenario import read_scenario_file
+    from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
+
     if args.out:  # format, folder and an existing file checked before the run
         SimResult.check_path(args.out, overwrite=args.force)
     table = read_scenario_file(path)
@@ -276,7 +280,7 @@ def _read_system_scenario(source: str, command: str):
 
 def _is_scenario_file(name: str) -> bool:
     """A scenario file, or the name of a shipped scenario (rather than a derivation or an observer set)."""
-    from uvsym.sim.scenario import every_shipped_scenario
+    from uvsym.sim.shipped import every_shipped_scenario
 
     return name.endswith(".toml") or Path(name).is_file() or name in every_shipped_scenario()
 
@@ -291,9 +295,11 @@ def _first_sentence(doc: str | None) -> str:
 
 
 def _cmd_codegen(args) -> int:
-    from uvsym.codegen.observer_sets import option_flags, options_of
+    from uvsym.derivation import observer_set, observer_sets
 
     if args.list or not args.name:
+        from uvsym.codegen.observer_sets import option_flags, options_of
+
         rows = [[name, study, option_flags(options_of(factory)), _first_sentence(factory.__doc__)]
                 for name, (study, factory) in observer_sets().items()]
         print(_table(rows, ["observer set", "derivation", "options", "description"]))
@@ -383,12 +389,13 @@ def _claim_block(row: dict, width: int = 100) -> str:
 def _cmd_verify(args) -> int:
     import time
 
+    scenario_files = [n for n in args.names if _is_scenario_file(n)]
+    studies = [n for n in args.names if not _is_scenario_file(n)]
+    chosen = [s for s in _selected(studies) if s.claims is not None] if studies or not scenario_files else []
     from uvsym.progress import ProgressBar
     from uvsym.report.markdown import write_json
     from uvsym.verify.certificate import STATUSES
 
-    scenario_files = [n for n in args.names if _is_scenario_file(n)]
-    studies = [n for n in args.names if not _is_scenario_file(n)]
     everything, failures = [], 0
 
     def claimed(name: str) -> Path:
@@ -412,8 +419,7 @@ def _cmd_verify(args) -> int:
             print("\n\n".join(_claim_block(r) for r in rows) + "\n")
             print("".join(f"   {note}\n" for note in notes))
 
-    if studies or not scenario_files:
-        chosen = [s for s in _selected(studies) if s.claims is not None]
+    if chosen:
         folders = [claimed(study.name) for study in chosen]  # every folder checked before any claim runs
         bar = ProgressBar("verify", total=len(chosen), unit="derivations", interval_s=0.0)
         for index, (study, out_dir) in enumerate(zip(chosen, folders)):
@@ -442,10 +448,12 @@ def _cmd_verify(args) -> int:
 
 
 def _cmd_campaign(args) -> int:
-    from uvsym.campaign import default_out, load_campaign, run_campaign
-    from uvsym.progress import ProgressBar
+    from uvsym.campaign.spec import load_campaign
 
     campaign = load_campaign(args.file, confirm=args.yes)
+    from uvsym.campaign.runner import default_out, run_campaign
+    from uvsym.progress import ProgressBar
+
     if args.dry_run:
         from uvsym.campaign.runner import executor_options
         from uvsym.campaign.worker import load_hook
@@ -496,7 +504,7 @@ def _parser() -> argparse.ArgumentParser:
     report.add_argument("--out", default="reports", help="output folder (default: ./reports)")
     report.add_argument("--force", action="store_true", help="write into folders holding files uvsym did not write")
     report.set_defaults(run=_cmd_report)
-    from uvsym.sim.run import METHODS
+    from uvsym.sim.integrator_options import METHODS
 
     simulate = sub.add_parser("simulate", help="run a scenario (a TOML file or a shipped example's name)")
     simulate.add_argument("scenario", nargs="?", help="scenario file or shipped name (none: list the shipped ones)")

@@ -18,7 +18,9 @@ What a derivation implements:
   (``vehicle``, ``form``, ...) and returns an :class:`~uvsym.codegen.observer_sets.ObserverSet`;
 - ``scenarios``, optional: shipped example scenario name -> TOML path, each a scenario over a plant
   (:mod:`uvsym.sim.system_scenario`) that ``uvsym simulate``, ``uvsym campaign``, ``uvsym codegen``
-  and ``uvsym verify`` take by its name.
+  and ``uvsym verify`` take by its name: the ``*.toml`` files of the ``scenarios/`` folder of the
+  derivation's package, by file name (uvsym finds them there without importing the derivation, and
+  refuses a derivation that declares others).
 
 What it gets for free:
 
@@ -38,20 +40,22 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from importlib.metadata import EntryPoint, entry_points
+from importlib.util import find_spec
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
-from uvsym.codegen.observer_sets import ObserverSet, make_observer_set
-from uvsym.errors import DerivationError, UnknownNameError
+from uvsym.errors import DerivationError, UnknownNameError, did_you_mean
 
 if TYPE_CHECKING:
+    from uvsym.codegen.observer_sets import ObserverSet
     from uvsym.verify.certificate import Certificate
 
-__all__ = ["GROUP", "Derivation", "DerivationError", "derivation", "load_derivations", "observer_set",
-           "observer_sets", "source_fingerprint", "study_scenarios"]
+__all__ = ["GROUP", "SCENARIO_FOLDER", "Derivation", "DerivationError", "derivation", "derivations",
+           "load_derivations", "observer_set", "observer_sets", "source_fingerprint", "study_scenarios"]
 
 GROUP = "uvsym.derivations"
+SCENARIO_FOLDER = "scenarios"  # in a derivation's package: its shipped scenarios, one TOML file each
 
 
 @dataclass(frozen=True)
@@ -96,7 +100,25 @@ def _load(ep: EntryPoint) -> Derivation:
         raise DerivationError(f"{where} is a {type(loaded).__name__}, not a uvsym.derivation.Derivation")
     if loaded.name != ep.name:
         raise DerivationError(f"{where} names a Derivation called {loaded.name!r}")
+    shipped = _shipped_files(ep)
+    if {k: v.resolve() for k, v in loaded.scenarios.items()} != {k: v.resolve() for k, v in shipped.items()}:
+        raise DerivationError(f"{where} declares the scenarios {sorted(loaded.scenarios) or 'none'}, not the files "
+                              f"of its package's {SCENARIO_FOLDER}/ folder ({sorted(shipped) or 'none'}), where uvsym "
+                              "finds them by name")
     return loaded
+
+
+def _shipped_files(ep: EntryPoint) -> dict[str, Path]:
+    """The scenario files of the package an entry point's module is (name -> path), found without importing it
+    (only its parent packages); none for a plain module or one that cannot be found (its loading reports why)."""
+    try:
+        spec = find_spec(ep.module)
+    except (ImportError, ValueError):  # a missing parent package; a module made at run time, without a spec
+        return {}
+    if spec is None or not spec.submodule_search_locations:
+        return {}
+    folder = Path(next(iter(spec.submodule_search_locations))) / SCENARIO_FOLDER
+    return {path.stem: path for path in sorted(folder.glob("*.toml"))}
 
 
 def load_derivations() -> dict[str, Derivation]:
@@ -106,10 +128,18 @@ def load_derivations() -> dict[str, Derivation]:
 
 def derivation(name: str) -> Derivation:
     """The installed derivation ``name`` (only it is loaded); UnknownNameError lists the known ones."""
+    return derivations([name])[0]
+
+
+def derivations(names: list[str]) -> list[Derivation]:
+    """The installed derivations ``names``, only those loaded, after every name is checked (UnknownNameError
+    with the closest name and the known ones)."""
     available = _entry_points()
-    if name not in available:
-        raise UnknownNameError(f"unknown derivation {name!r}; known: {', '.join(available) or 'none installed'}")
-    return _load(available[name])
+    for name in names:
+        if name not in available:
+            raise UnknownNameError(f"unknown derivation {name!r}{did_you_mean(name, available)}; "
+                                   f"known: {', '.join(available) or 'none installed'}")
+    return [_load(available[name]) for name in names]
 
 
 def observer_sets() -> dict[str, tuple[str, Callable[..., ObserverSet]]]:
@@ -126,20 +156,24 @@ def observer_sets() -> dict[str, tuple[str, Callable[..., ObserverSet]]]:
 
 def observer_set(name: str, **options) -> ObserverSet:
     """The observer set ``name`` built with ``options``; UnknownNameError for an unknown set or option."""
+    from uvsym.codegen.observer_sets import make_observer_set
+
     available = observer_sets()
     if name not in available:
-        raise UnknownNameError(f"unknown observer set {name!r}; known: {', '.join(available) or 'none declared'}")
+        raise UnknownNameError(f"unknown observer set {name!r}{did_you_mean(name, available)}; "
+                               f"known: {', '.join(available) or 'none declared'}")
     return make_observer_set(name, available[name][1], **options)
 
 
 def study_scenarios() -> dict[str, tuple[str, Path]]:
-    """Every scenario the installed derivations ship: name -> (derivation name, TOML path)."""
+    """Every scenario the installed derivations ship (their packages' ``scenarios/`` folders, no derivation
+    imported): name -> (derivation name, TOML path)."""
     found: dict[str, tuple[str, Path]] = {}
-    for study in load_derivations().values():
-        for name, path in study.scenarios.items():
+    for study, ep in _entry_points().items():
+        for name, path in _shipped_files(ep).items():
             if name in found:
-                raise DerivationError(f"scenario {name!r} is shipped by both {found[name][0]!r} and {study.name!r}")
-            found[name] = (study.name, path)
+                raise DerivationError(f"scenario {name!r} is shipped by both {found[name][0]!r} and {study!r}")
+            found[name] = (study, path)
     return dict(sorted(found.items()))
 
 

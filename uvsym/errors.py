@@ -5,6 +5,7 @@ Every error a user can cause is one of these, and its message names the problem
 """
 
 __all__ = [
+    "did_you_mean",
     "UvsymError",
     "ModelError",
     "KinematicsError",
@@ -164,3 +165,11 @@ class CampaignSizeError(CampaignError):
 class ExecutorError(SimulationError):
     """A campaign's executor cannot run: an unreachable scheduler (names the address) or a missing
     optional dependency (names the extra to install)."""
+
+
+def did_you_mean(name: str, known) -> str:
+    """`` (did you mean 'x'?)`` with the closest of ``known`` to a misspelt ``name``, or "" when none is close."""
+    import difflib
+
+    near = difflib.get_close_matches(name, [str(k) for k in known], n=1)
+    return f" (did you mean {near[0]!r}?)" if near else ""

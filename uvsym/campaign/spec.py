@@ -36,10 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.campaign.dotted import flatten, new_entry, parse_path, set_path
-from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError
+from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError, did_you_mean
 from uvsym.sim.fields import Fields
-from uvsym.sim.scenario import every_shipped_scenario, read_scenario_file
-from uvsym.sim.system_scenario import is_system_scenario, parse_any_scenario
+from uvsym.sim.shipped import every_shipped_scenario
 
 __all__ = ["Campaign", "Run", "Settings", "load_campaign", "parse_campaign", "DISTRIBUTIONS", "EXECUTORS", "storable"]
 
@@ -139,6 +138,8 @@ def parse_campaign(data: dict, root=".", default_name: str = "campaign", *, conf
             raise CampaignError(f"case {run.case!r}: two runs have the same scenario ({_describe(run.fields)}); "
                                 "remove the repeated grid value")
         seen[run.id] = run
+    from uvsym.sim.system_scenario import is_system_scenario  # the simulator: imported once the file is read
+
     if "substeps" in dict(simulation) and any(is_system_scenario(run.scenario) for run in runs):
         raise CampaignError("simulation.substeps: a scenario over a plant sets its own substeps (substeps = N in "
                             "the scenario, or a case's set)")
@@ -176,7 +177,7 @@ def _executor(fields: Fields) -> dict:
 
 
 def _simulation(fields: Fields) -> tuple:
-    from uvsym.sim.run import METHODS
+    from uvsym.sim.integrator_options import METHODS
 
     options = {"method": fields.text("method", "fast", choices=METHODS)}
     compiled = fields.raw("compiled", True)
@@ -191,13 +192,16 @@ def _simulation(fields: Fields) -> tuple:
 
 
 def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
+    from uvsym.sim.scenario import read_scenario_file
+    from uvsym.sim.system_scenario import is_system_scenario
+
     source = fields.text("scenario")
     path = root / source
     if not path.is_file():
         shipped = every_shipped_scenario()
         if source not in shipped:
-            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}; "
-                                f"shipped: {', '.join(shipped)}")
+            raise CampaignError(f"{fields.path}.scenario: no file {path} and no shipped scenario {source!r}"
+                                f"{did_you_mean(source, shipped)}; shipped: {', '.join(shipped)}")
         path = shipped[source]
     try:
         table = read_scenario_file(path)
@@ -374,6 +378,8 @@ def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: 
     if huge:
         raise CampaignError(f"case {case!r}, run {_describe(fields)}: {huge[0]} = {fields[huge[0]]!r:.40} holds an "
                             "integer beyond 64 bits, which the results table cannot store")
+    from uvsym.sim.system_scenario import parse_any_scenario
+
     try:
         parse_any_scenario(table, default_name=scenario_name)
     except UvsymError as exc:

@@ -1,41 +1,24 @@
 """Simulation: closed loops of a Model with controllers, observers, faults and supervisors, and
-closed loops of any System with blocks wired by signal name."""
+closed loops of any System with blocks wired by signal name.
 
-from uvsym.sim.blocks import Block, block, observer_block, renamed
-from uvsym.sim.closed_loop import ClosedLoop, build_closed_loop
-from uvsym.sim.controllers import Autopilot, LineOfSight, Loop
-from uvsym.sim.feedback import lqr, lqr_gain, open_loop, pid, state_feedback
-from uvsym.sim.loop import SampledLoop
-from uvsym.sim.result import Signal, SimResult
-from uvsym.sim.run import METHODS, Correction, Substitution, Supervisor
-from uvsym.sim.simulation import simulate
-from uvsym.sim.system_simulation import simulate_system
-from uvsym.sim.wiring import WiredLoop, interconnect
+The names below are imported on first use (:mod:`uvsym.lazy`): importing one submodule (the scenario
+lookup of ``uvsym simulate``, the integration methods) does not import the simulator.
+"""
 
-__all__ = [
-    "METHODS",
-    "Autopilot",
-    "Block",
-    "ClosedLoop",
-    "Correction",
-    "LineOfSight",
-    "Loop",
-    "SampledLoop",
-    "Signal",
-    "SimResult",
-    "Substitution",
-    "Supervisor",
-    "WiredLoop",
-    "block",
-    "build_closed_loop",
-    "interconnect",
-    "lqr",
-    "lqr_gain",
-    "observer_block",
-    "open_loop",
-    "pid",
-    "renamed",
-    "simulate",
-    "simulate_system",
-    "state_feedback",
-]
+from uvsym.lazy import lazy_exports
+
+_EXPORTS = {  # name -> the submodule that defines it
+    **dict.fromkeys(["Block", "block", "observer_block", "renamed"], "blocks"),
+    **dict.fromkeys(["ClosedLoop", "build_closed_loop"], "closed_loop"),
+    **dict.fromkeys(["Autopilot", "LineOfSight", "Loop"], "controllers"),
+    **dict.fromkeys(["lqr", "lqr_gain", "open_loop", "pid", "state_feedback"], "feedback"),
+    "SampledLoop": "loop",
+    **dict.fromkeys(["Signal", "SimResult"], "result"),
+    "METHODS": "integrator_options",
+    **dict.fromkeys(["Correction", "Substitution", "Supervisor"], "run"),
+    "simulate": "simulation",
+    "simulate_system": "system_simulation",
+    **dict.fromkeys(["WiredLoop", "interconnect"], "wiring"),
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

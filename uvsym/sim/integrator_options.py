@@ -9,6 +9,10 @@ from collections.abc import Mapping
 
 from uvsym.errors import SimulationError
 
+__all__ = ["METHODS", "checked_options"]
+
+METHODS = ("fast", "cvodes", "idas", "rk", "collocation")  # the compiled fixed-step RK4, then CasADi's integrators
+
 
 def checked_options(method: str, options) -> dict:
     """``options`` (None: none) as a dict for ``method``'s CasADi integrator; SimulationError for options given to

@@ -28,7 +28,7 @@ import numpy as np
 from uvsym.codegen import compile_roll, find_compiler
 from uvsym.errors import CodegenError, SimulationError, UvsymError
 from uvsym.observers.ftc import Correction
-from uvsym.sim.integrator_options import checked_options
+from uvsym.sim.integrator_options import METHODS, checked_options
 from uvsym.sim.loop import SampledLoop
 from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.step_error import TOLERANCE, check_tolerance, checked_steps
@@ -36,7 +36,6 @@ from uvsym.sim.step_error import TOLERANCE, check_tolerance, checked_steps
 __all__ = ["METHODS", "Correction", "Substitution", "Supervisor", "run_closed_loop", "check_chunk", "check_memory",
            "memory_needed"]
 
-METHODS = ("fast", "cvodes", "idas", "rk", "collocation")
 MAX_SAMPLES = 1e12  # beyond any machine's memory at 8 bytes a sample and signal
 # samples per call between progress reports (no supervisor): the fast path pays per call, the
 # integrators step in Python anyway

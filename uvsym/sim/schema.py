@@ -14,7 +14,8 @@ type's own fields under ``blocks[<type>]`` and ``detectors[<type>]``.
 
 from __future__ import annotations
 
-from uvsym.sim.scenario import every_shipped_scenario, parse_scenario, read_scenario_file, shipped_scenarios
+from uvsym.sim.scenario import parse_scenario, read_scenario_file
+from uvsym.sim.shipped import every_shipped_scenario, shipped_scenarios
 
 __all__ = ["schema_markdown", "scenario_schema"]
 
