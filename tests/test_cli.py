@@ -129,6 +129,24 @@ def test_simulate_writes_result_and_figure(tmp_path, capsys):
     assert (tmp_path / "run.svg").read_text().startswith("<?xml")
 
 
+def test_simulate_compresses_its_result_only_when_asked(tmp_path, capsys):
+    import zipfile
+
+    scenario = tmp_path / "short.toml"
+    text = (Path(uvsym.__file__).parent / "sim" / "scenarios" / "docking_faults.toml").read_text()
+    scenario.write_text(text.replace("duration = 90.0", "duration = 2.0"))
+    for name, flags, kind in (("plain.npz", [], zipfile.ZIP_STORED),
+                              ("packed.npz", ["--compress"], zipfile.ZIP_DEFLATED)):
+        assert main(["simulate", str(scenario), "--out", str(tmp_path / name), *flags]) == 0
+        with zipfile.ZipFile(tmp_path / name) as archive:
+            assert {entry.compress_type for entry in archive.infolist()} == {kind}, name
+    capsys.readouterr()
+    status, stderr = exit_status(capsys, "simulate", str(scenario), "--compress")
+    assert status == 2 and "--compress: it compresses the --out file; give one" in stderr
+    status, stderr = exit_status(capsys, "simulate", str(scenario), "--out", str(tmp_path / "run.csv"), "--compress")
+    assert status == 2 and "only .npz and .mat files are compressed" in stderr and not (tmp_path / "run.csv").exists()
+
+
 def test_simulate_reports_a_bad_scenario_field_and_exits_2(tmp_path, capsys):
     scenario = tmp_path / "bad.toml"
     text = (Path(uvsym.__file__).parent / "sim" / "scenarios" / "docking_faults.toml").read_text()

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from uvsym.errors import FileFormatError, PathError, SimulationError
-from uvsym.sim.result import FORMATS, Signal, SimResult
+from uvsym.sim.result import COMPRESSED, FORMATS, Signal, SimResult
 
 # every string a result accepts: no control characters, no lone surrogates (UTF-8 encodable)
 TEXT = st.text(st.characters(blacklist_categories=("Cc", "Cs")), max_size=12)
@@ -52,6 +52,30 @@ def _assert_same(loaded: SimResult, original: SimResult) -> None:
 def test_every_valid_result_round_trips_exactly(tmp_path, suffix, result):
     path = result.save(tmp_path / f"r{suffix}", overwrite=True)
     _assert_same(SimResult.load(path), result)
+
+
+@pytest.mark.parametrize("suffix", COMPRESSED)
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(result=results())
+def test_every_valid_result_round_trips_exactly_compressed_too(tmp_path, suffix, result):
+    path = result.save(tmp_path / f"r{suffix}", overwrite=True, compress=True)
+    _assert_same(SimResult.load(path), result)
+
+
+def test_results_are_compressed_only_when_asked_and_only_in_the_formats_that_compress(tmp_path):
+    n = 20_000  # a long, regular run: what compression shrinks
+    result = SimResult(np.arange(n) * 0.01, {"x": Signal(np.zeros((n, 3)), ("a", "b", "c"), ("m", "m", "m"))})
+    plain, packed = result.save(tmp_path / "plain.npz"), result.save(tmp_path / "packed.npz", compress=True)
+    for path, kind in ((plain, zipfile.ZIP_STORED), (packed, zipfile.ZIP_DEFLATED)):
+        with zipfile.ZipFile(path) as archive:
+            assert {entry.compress_type for entry in archive.infolist()} == {kind}, path.name
+        _assert_same(SimResult.load(path), result)
+    plain, packed = result.save(tmp_path / "plain.mat"), result.save(tmp_path / "packed.mat", compress=True)
+    assert packed.stat().st_size < plain.stat().st_size / 10  # 640 kB of zeros
+    _assert_same(SimResult.load(packed), result)
+    with pytest.raises(SimulationError, match=r"cannot compress .*run.csv: only .npz and .mat files are compressed"):
+        result.save(tmp_path / "run.csv", compress=True)
+    assert not (tmp_path / "run.csv").exists()
 
 
 @pytest.mark.parametrize("suffix", FORMATS)

@@ -186,8 +186,10 @@ def _cmd_simulate(args) -> int:
     from uvsym.sim.scenario import read_scenario_file
     from uvsym.sim.system_scenario import parse_any_scenario, simulate_any_scenario
 
+    if args.compress and not args.out:
+        raise UvsymError("--compress: it compresses the --out file; give one (.npz or .mat)")
     if args.out:  # format, folder and an existing file checked before the run
-        SimResult.check_path(args.out, overwrite=args.force)
+        SimResult.check_path(args.out, overwrite=args.force, compress=args.compress)
     table = read_scenario_file(path)
     scenario = parse_any_scenario(table, default_name=path.stem, root=path.parent)
     if args.events is not None:
@@ -208,7 +210,7 @@ def _cmd_simulate(args) -> int:
     x = result["x"]
     print("final state: " + ", ".join(f"{lab} = {v:.4g} {u}" for lab, v, u in zip(x.labels, x.values[-1], x.units)))
     if args.out:
-        print(f"wrote {result.save(args.out, overwrite=args.force)}")
+        print(f"wrote {result.save(args.out, overwrite=args.force, compress=args.compress)}")
     if detector_names(scenario):  # a vehicle's [diagnosis] table, or [[detectors]]
         print(_event_lines(result.events))
     if getattr(scenario, "diagnosis", None) is not None:
@@ -511,6 +513,8 @@ def _parser() -> argparse.ArgumentParser:
     simulate.add_argument("--method", choices=METHODS, default=None,
                           help="fast (compiled fixed-step RK4, default) or a CasADi integrator")
     simulate.add_argument("--out", help="write the result (.npz, .csv or .mat)")
+    simulate.add_argument("--compress", action="store_true", help="compress the --out .npz or .mat file (about "
+                                                                 "half the size, far slower to write for a long run)")
     simulate.add_argument("--plot", nargs="?", const="", default=None,
                           help="write a quick-look figure (.svg or .png; default: next to --out)")
     simulate.add_argument("--list", action="store_true", help="list the shipped scenarios")
