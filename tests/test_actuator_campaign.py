@@ -37,6 +37,39 @@ def test_counts_use_only_identifiable_excited_runs_and_fault_free_false_alarms()
     assert met["median isolation delay <= 5 s"]
 
 
+def test_a_campaign_whose_every_run_crashed_is_reported_as_such_without_a_nan(tmp_path):
+    """Every run an error row (e.g. its worker could not import uvsym): the figures of no run are None, every
+    target that needs a run is missed, and results.json and the confusion figure are written."""
+    import json
+    from collections import Counter
+
+    from derivations.actuator_observers.figures import campaign_confusion_figure
+    from uvsym.report.markdown import write_json
+
+    figures = counts([_row(status="error"), _row(status="error", true_actuator=None, true_kind=None)])
+    assert figures["campaign_crashes"] == 2 and figures["campaign_counted_runs"] == 0
+    for key in ("campaign_correct_fraction", "campaign_correct_fraction_all_faults",
+                "campaign_median_isolation_delay_s", "campaign_max_isolation_delay_s"):
+        assert figures[key] is None, key
+    met = targets(figures)
+    assert [name for name, ok in met.items() if ok] == ["no false alarm without a fault"]  # no run to alarm
+    write_json(tmp_path / "results.json", figures)
+    assert json.loads((tmp_path / "results.json").read_text())["campaign_max_isolation_delay_s"] is None
+    campaign_confusion_figure(Counter(), tmp_path / "confusion.svg")
+    assert (tmp_path / "confusion.svg").read_text().startswith("<?xml")
+
+
+def test_json_with_a_nan_is_refused_naming_the_entry_before_the_file_is_written(tmp_path):
+    from uvsym.errors import FileFormatError
+    from uvsym.report.markdown import write_json
+
+    with pytest.raises(FileFormatError, match=r"results.json: campaign.delays\[1\] is nan, which JSON cannot hold"):
+        write_json(tmp_path / "results.json", {"campaign": {"runs": 2, "delays": [1.0, float("nan")]}})
+    with pytest.raises(FileFormatError, match=r"inf"):
+        write_json(tmp_path / "results.json", [np.float64("inf")])
+    assert not (tmp_path / "results.json").exists()
+
+
 def test_size_intervals_count_right_decisions_against_tolerance_and_stated_std():
     rows = [_row(case="a", size_error_std=0.5), _row(case="a", size_error_rel=0.03, size_error_std=2.5),
             _row(case="a", isolated_kind="proportional", size_error_std=9.0),  # wrong kind: not a size case

@@ -89,6 +89,10 @@ def huge(scenario, result, events):
     return {"count": 2 ** 64}
 
 
+def failing(scenario, result, events):
+    raise RuntimeError("no such sensor")
+
+
 def flaky(scenario, result, events):
     """Kills its worker the first time it runs seed 2 (a marker file remembers), runs normally after."""
     marker = LOG.with_name("died.marker")
@@ -442,6 +446,34 @@ def test_a_worker_that_dies_gives_an_error_row_and_the_others_finish(tmp_path):
     assert f"{RETRIES + 1} times" in rows[1]["error"]  # tried again in new processes first
     assert rows[1]["true_actuator"] == "X"  # truth is known without the run
     assert sorted(_executed(tmp_path)) == [1, 3]
+
+
+def test_a_campaign_whose_every_run_failed_exits_1_naming_the_commonest_error(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["campaign", str(_tiny(tmp_path, "failing")), "--out", str(out)]) == 1
+    assert ("uvsym: error: all 2 runs of tiny failed, 2 with: RuntimeError: no such sensor (each run's "
+            f"error: the error column of {out / 'results.csv'})") in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())  # written all the same, saying so
+    assert (summary["runs"], summary["ok"], summary["errors"]) == (2, 0, 2)
+    assert "2 of 2 runs finished: 0 ok, 2 with an error" in (out / "report.md").read_text()
+
+
+def test_workers_import_the_drivers_uvsym_not_a_folder_named_uvsym_in_the_working_folder(tmp_path):
+    """Run from a folder holding one named uvsym (the parent of a checkout), as the console script runs: its
+    own folder first on sys.path, not the working folder. Every run is made by the driver's uvsym."""
+    work, launcher = tmp_path / "work", tmp_path / "bin" / "launch.py"
+    (work / "uvsym").mkdir(parents=True)
+    (work / "uvsym" / "__init__.py").write_text('raise ImportError("the working folder\'s uvsym")\n')
+    launcher.parent.mkdir()
+    launcher.write_text("import sys\nfrom uvsym.cli import main\nif __name__ == '__main__':\n"
+                        "    sys.exit(main(sys.argv[1:]))\n")  # as a console script is
+    path = _tiny(work)
+    run = subprocess.run([sys.executable, str(launcher), "campaign", path.name, "--out", "out"], cwd=work,
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
+    rows = pq.read_table(work / "out" / "results.parquet").to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "ok"], [r["error"] for r in rows]
+    assert sorted(_executed(work)) == [1, 2]
 
 
 def test_a_run_whose_worker_died_once_is_tried_again_in_a_new_process(tmp_path):

@@ -473,12 +473,20 @@ def _cmd_campaign(args) -> int:
 
     out = Path(args.out) if args.out else default_out(campaign)
     try:
-        run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
-                     chunk_size=args.chunk_size, progress=bar, force=args.force, log=log)
+        table = run_campaign(campaign, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                             chunk_size=args.chunk_size, progress=bar, force=args.force, log=log)
     except KeyboardInterrupt:
         log(f"interrupted: the finished chunks are kept in {out / 'chunks'}; run the same command to resume")
         return 130
     print(f"wrote {out}: results.parquet, results.csv, summary.json, report.md, report.html")
+    errors = [row["error"] for row in table.select(["status", "error"]).to_pylist() if row["status"] != "ok"]
+    if errors and len(errors) == table.num_rows:  # nothing to summarize: a setup fault, not the scenarios'
+        from collections import Counter
+
+        error, count = Counter(errors).most_common(1)[0]
+        print(f"uvsym: error: all {len(errors)} runs of {campaign.name} failed, {count} with: {error} (each run's "
+              f"error: the error column of {out / 'results.csv'})", file=sys.stderr)
+        return 1
     return 0
 
 

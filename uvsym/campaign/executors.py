@@ -37,12 +37,17 @@ def default_workers() -> int:
 # one thread per worker process for the numeric libraries, as Dask's nanny does: idle BLAS threads spin and
 # take cores from the other workers' runs
 _SINGLE_THREADED = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+# the forkserver starts as 'python -c', which would put the working folder first on its sys.path: a folder
+# there named uvsym (the parent of a checkout) would be the uvsym its preload imports and every worker inherits.
+# Without it (safe path) the forkserver finds the parent's uvsym; each worker then takes the parent's sys.path.
+_SAFE_PATH = {"PYTHONSAFEPATH": "1"}
 
 
 @contextlib.contextmanager
 def _worker_environment():
-    """os.environ with _SINGLE_THREADED where the user set none, for processes (and the forkserver) started inside."""
-    added = {key: value for key, value in _SINGLE_THREADED.items() if key not in os.environ}
+    """os.environ with _SINGLE_THREADED and _SAFE_PATH where the user set none, for processes (and the forkserver)
+    started inside."""
+    added = {key: value for key, value in (_SINGLE_THREADED | _SAFE_PATH).items() if key not in os.environ}
     os.environ.update(added)
     try:
         yield

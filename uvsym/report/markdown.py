@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from uvsym.errors import FileFormatError
+
 __all__ = ["markdown_table", "latex_matrix", "write_json"]
 
 
@@ -31,5 +33,27 @@ def latex_matrix(matrix, digits: int = 6) -> str:
 
 
 def write_json(path: Path, data) -> None:
-    """Write JSON with sorted keys and a trailing newline, so equal data give equal bytes."""
-    Path(path).write_text(json.dumps(data, indent=2, sort_keys=True, allow_nan=False) + "\n")
+    """Write JSON with sorted keys and a trailing newline, so equal data give equal bytes; FileFormatError
+    naming the entry, before anything is written, for a NaN or infinity (JSON has none: a missing figure is None)."""
+    try:
+        text = json.dumps(data, indent=2, sort_keys=True, allow_nan=False)
+    except ValueError:
+        where = _non_finite(data, "")
+        if where is None:  # another ValueError (a circular reference): json's own message
+            raise
+        raise FileFormatError(f"cannot write {path}: {where[0] or 'the value'} is {where[1]}, which JSON cannot "
+                              "hold (a figure without a value, e.g. of no finished run, is None: null)") from None
+    Path(path).write_text(text + "\n")
+
+
+def _non_finite(data, where: str) -> tuple[str, float] | None:
+    """(path, value) of the first NaN or infinity in ``data`` (dicts by key, lists by index), or None."""
+    if isinstance(data, float):
+        return None if np.isfinite(data) else (where, data)
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, (list, tuple)) else ()
+    for key, value in items:
+        found = _non_finite(value, f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else
+                            str(key))
+        if found is not None:
+            return found
+    return None

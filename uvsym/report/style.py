@@ -123,7 +123,7 @@ def confusion_matrix(ax, counts, true_labels: Sequence[str], decided_labels: Seq
     """Counts (runs) of each true class (rows) against each decision (columns), annotated in a colour
     that contrasts with the cell (white on dark, black on light); zero cells left blank."""
     counts = np.asarray(counts, dtype=float)
-    image = ax.imshow(counts, cmap="Blues", vmin=0, vmax=max(counts.max(), 1), aspect="auto")
+    image = ax.imshow(counts, cmap="Blues", vmin=0, vmax=max(counts.max(initial=0.0), 1), aspect="auto")  # none: blank
     size = 8 if max(counts.shape) <= 8 else 7
     for (i, j), count in np.ndenumerate(counts):
         if count:
