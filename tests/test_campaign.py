@@ -233,6 +233,33 @@ def test_bad_campaigns_are_refused_naming_the_field(tmp_path):
     assert len(load_campaign(tmp_path / "campaign.toml", confirm=True).runs) == 8
 
 
+def test_a_case_sets_its_own_simulation_options_over_the_campaigns(tmp_path, monkeypatch):
+    """[case.simulation] gives the options it names (compiled = true: long healthy runs sharing one compiled
+    loop), the others keep [simulation]'s; the worker passes them on; a bad one is named with its case."""
+    text = GRID.replace("[case.grid]", "[case.simulation]\ncompiled = true\n[case.grid]")
+    campaign = load_campaign(_write(tmp_path, text.replace("[[case]]", "[simulation]\ncompiled = false\n"
+                                                                        "method = 'fast'\n[[case]]", 1)))
+    assert dict(campaign.settings.simulation) == {"method": "fast", "compiled": False}
+    assert all(run.simulation == (("compiled", True),) for run in campaign.runs)
+    import uvsym.sim.system_scenario as system_scenario
+    from uvsym.campaign.worker import execute
+
+    given = {}
+
+    def record(scenario, **options):
+        given.update(options)
+        raise RuntimeError("stop after the options")
+
+    monkeypatch.setattr(system_scenario, "simulate_any_scenario", record)
+    row = execute(campaign.runs[0], campaign.settings)
+    assert given == {"method": "fast", "compiled": True} and row["status"] == "error"
+    bad = GRID.replace("[case.grid]", "[case.simulation]\ncompiled = 'yes'\n[case.grid]")
+    with pytest.raises(CampaignError, match=r"case\[0\].simulation.compiled: expected true or false"):
+        load_campaign(_write(tmp_path, bad))
+    with pytest.raises(CampaignError, match=r"case\[0\].simulation.methd: unknown field"):
+        load_campaign(_write(tmp_path, GRID.replace("[case.grid]", "[case.simulation]\nmethd = 'fast'\n[case.grid]")))
+
+
 def test_the_command_reports_bad_input_and_size(tmp_path, capsys):
     path = _write(tmp_path, GRID + '"durration" = [10.0]\n')
     assert main(["campaign", str(path), "--out", str(tmp_path / "out")]) == 2

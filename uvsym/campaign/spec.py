@@ -4,17 +4,17 @@ A campaign file (TOML) holds ``name``, ``description``, ``max_runs`` (default 10
 confirmation), ``metrics`` (``module:function(scenario, result, events) -> dict`` of extra columns:
 ``scenario`` the run's validated :class:`~uvsym.sim.scenario.Scenario` (its faults as
 ``actuator_faults`` and ``sensor_faults``), ``result`` its SimResult, ``events`` its decision log),
-``roc_by`` (field paths grouping the ROC points), ``[executor]`` (kind, workers, scheduler,
-chunk_size, timeout_s: how long to wait for a Dask scheduler to answer, not a limit per run),
-``[simulation]`` (method, compiled, substeps: options of
-:func:`~uvsym.sim.simulation.simulate_scenario`) and one or more ``[[case]]`` tables: ``name``,
-``scenario`` (a shipped scenario or a path relative to the campaign file), ``set`` (dotted path ->
-value, every run of the case), ``[case.grid]`` (dotted path -> list of values, full product, in
-file order) and ``[case.monte_carlo]`` (``runs`` draws per grid point from the master ``seed``, an
-integer; dotted path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}``
-(both ends included) or ``{choice = [...]}``; ``seed = {integers = [lo, hi]}`` draws the scenario's
-own noise seed, the master seed then ``master_seed``, default 0). Paths follow
-:mod:`uvsym.campaign.dotted`.
+``roc_by`` (field paths grouping the ROC points), ``[executor]`` (kind, workers, scheduler, chunk_size,
+timeout_s: how long to wait for a Dask scheduler to answer, not a limit per run), ``[simulation]``
+(method, compiled, substeps: options of :func:`~uvsym.sim.simulation.simulate_scenario`) and one or more
+``[[case]]`` tables: ``name``, ``scenario`` (a shipped scenario or a path relative to the campaign
+file), ``set`` (dotted path -> value, every run of the case), ``[case.simulation]`` (the options of
+``[simulation]`` it gives, for the case's runs: e.g. ``compiled = true`` for long fault-free runs that
+share one compiled loop), ``[case.grid]`` (dotted path -> list of values, full product, in file order)
+and ``[case.monte_carlo]`` (``runs`` draws per grid point from the master ``seed``, an integer; dotted
+path -> ``{uniform = [lo, hi]}``, ``{normal = [mean, std]}``, ``{integers = [lo, hi]}`` (both ends
+included) or ``{choice = [...]}``; ``seed = {integers = [lo, hi]}`` draws the scenario's own noise seed,
+the master seed then ``master_seed``, default 0). Paths follow :mod:`uvsym.campaign.dotted`.
 
 A case's scenario is a vehicle scenario or a scenario over any plant (``plant = ...``,
 :mod:`uvsym.sim.system_scenario`); every run's scenario is parsed when the campaign is loaded, so a
@@ -51,13 +51,15 @@ _SETTING_ROOTS = ("diagnosis", "observers", "detectors", "blocks")
 @dataclass(frozen=True)
 class Run:
     """One run: ``id`` (16 hex digits), its case, Monte Carlo draw (None without), the values of its
-    grid and drawn fields (column -> value, tables flattened), and its scenario table."""
+    grid and drawn fields (column -> value, tables flattened), its scenario table, and the simulation
+    options its case sets over the campaign's (name, value pairs)."""
 
     id: str
     case: str
     draw: int | None
     fields: dict
     scenario: dict
+    simulation: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -140,7 +142,7 @@ def parse_campaign(data: dict, root=".", default_name: str = "campaign", *, conf
         seen[run.id] = run
     from uvsym.sim.system_scenario import is_system_scenario  # the simulator: imported once the file is read
 
-    if "substeps" in dict(simulation) and any(is_system_scenario(run.scenario) for run in runs):
+    if any("substeps" in dict(simulation) | dict(run.simulation) and is_system_scenario(run.scenario) for run in runs):
         raise CampaignError("simulation.substeps: a scenario over a plant sets its own substeps (substeps = N in "
                             "the scenario, or a case's set)")
     columns = tuple(dict.fromkeys(column for run in runs for column in run.fields))
@@ -176,19 +178,21 @@ def _executor(fields: Fields) -> dict:
     return executor
 
 
-def _simulation(fields: Fields) -> tuple:
+def _simulation(fields: Fields, given_only: bool = False) -> tuple:
+    """The ``[simulation]`` options as (name, value) pairs; ``given_only``: only those the table gives
+    (a case's, over the campaign's)."""
     from uvsym.sim.integrator_options import METHODS
 
     options = {"method": fields.text("method", "fast", choices=METHODS)}
     compiled = fields.raw("compiled", True)
     if not isinstance(compiled, bool):
-        raise CampaignError(f"simulation.compiled: expected true or false, got {compiled!r}")
+        raise CampaignError(f"{fields._name('compiled')}: expected true or false, got {compiled!r}")
     options["compiled"] = compiled
     substeps = _integer(fields, "substeps", 1, 1)
-    if substeps != 1:
+    if substeps != 1 or (given_only and fields.has("substeps")):
         options["substeps"] = substeps
     fields.done()
-    return tuple(options.items())
+    return tuple((key, value) for key, value in options.items() if not given_only or fields.has(key))
 
 
 def _scenario_table(fields: Fields, root: Path) -> tuple[dict, str]:
@@ -226,6 +230,8 @@ def _case(fields: Fields, root: Path) -> dict:
             _apply(base, path, value, f"{where}: set")
         grid = fields.raw("grid", None)
         monte_carlo = fields.raw("monte_carlo", None)
+        simulation = fields.table("simulation")
+        simulation = () if simulation is None else _simulation(simulation, given_only=True)
         fields.done()
     except CampaignError:
         raise
@@ -243,7 +249,8 @@ def _case(fields: Fields, root: Path) -> dict:
                 raise CampaignError(f"{where}: grid axis {path!r} is an empty list: the grid has no runs")
             axes.append((path, values))
     draws = None if monte_carlo is None else _monte_carlo(monte_carlo, where)
-    return {"name": name, "base": base, "scenario": scenario_name, "axes": axes, "draws": draws}
+    return {"name": name, "base": base, "scenario": scenario_name, "axes": axes, "draws": draws,
+            "simulation": simulation}
 
 
 def _monte_carlo(table, where: str):
@@ -339,7 +346,7 @@ def _expand(spec: dict) -> list[Run]:
             _apply(table, path, value, f"{where}: grid axis {path!r}")
             fields |= flatten(path, value)
         if spec["draws"] is None:
-            runs.append(_run(name, None, fields, table, spec["scenario"], made))
+            runs.append(_run(name, None, fields, table, spec["scenario"], made, spec["simulation"]))
             continue
         count, seed, distributions = spec["draws"]
         digest = hashlib.sha256(json.dumps([name, point], sort_keys=True, default=str).encode()).digest()
@@ -351,7 +358,7 @@ def _expand(spec: dict) -> list[Run]:
                 value = _draw(rng, kind, args)
                 _apply(drawn, path, value, f"{where}: monte_carlo field {path!r}")
                 drawn_fields |= flatten(path, value)
-            runs.append(_run(name, draw, drawn_fields, drawn, spec["scenario"], made))
+            runs.append(_run(name, draw, drawn_fields, drawn, spec["scenario"], made, spec["simulation"]))
     return runs
 
 
@@ -371,9 +378,10 @@ def storable(value) -> bool:
     return True
 
 
-def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str, made=()) -> Run:
+def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: str, made=(),
+         simulation: tuple = ()) -> Run:
     """The parsed run; made: list entries (``faults[1]``) the case's paths add to its scenario (named
-    in an error that is about one of them)."""
+    in an error that is about one of them); simulation: the case's options."""
     huge = [column for column, value in fields.items() if not storable(value)]
     if huge:
         raise CampaignError(f"case {case!r}, run {_describe(fields)}: {huge[0]} = {fields[huge[0]]!r:.40} holds an "
@@ -392,5 +400,5 @@ def _run(case: str, draw: int | None, fields: dict, table: dict, scenario_name: 
     table.setdefault("name", scenario_name)
     key = json.dumps({"case": case, "scenario": table}, sort_keys=True, default=str)
     return Run(id=hashlib.sha256(key.encode()).hexdigest()[:16], case=case, draw=draw, fields=fields,
-               scenario=table)
+               scenario=table, simulation=simulation)
 

@@ -67,7 +67,7 @@ def execute(run: Run, settings: Settings, hook=None) -> dict:
     try:
         scenario = parse_any_scenario(run.scenario)
         row |= truth(scenario)
-        result = simulate_any_scenario(scenario, **dict(settings.simulation))
+        result = simulate_any_scenario(scenario, **(dict(settings.simulation) | dict(run.simulation)))
         events = list(getattr(result, "events", None) or [])
         row |= run_metrics(scenario, result, events)
         if hook is not None:
