@@ -414,10 +414,21 @@ def test_an_uncertified_gain_says_why_or_else_how_it_was_checked(monkeypatch, re
 def test_synthesis_scalar_optimum_matches_the_closed_form():
     # n = p = 1, A = 0, C = c: minimise P + |Y| s.t. P >= 1, 2 d P - 2 c Y <= -1e-6 with d = 1.01 + 1e-6,
     # so P = 1 and L = Y = (d + 5e-7) / c.
+    # L is then rounded to GAIN_DIGITS (5) significant digits: 101000.15 -> 101000.
     c = 1e-5
     design = synthesize_observer_gain([[0.0]], [[c]], decay=1.0)
     assert design.P[0, 0] == pytest.approx(1.0, abs=1e-6)
-    assert design.L[0, 0] == pytest.approx((1.01 + 1.5e-6) / c, abs=5e-3)
+    assert design.L[0, 0] == 101000.0
+
+
+def test_a_rounded_gain_is_kept_only_where_it_certifies():
+    """At decay 0 with an unobservable mode at 0.5 - l2, the optimum l2 = 0.5 + 5e-7 rounds to 0.5, a closed-loop
+    eigenvalue at exactly 0: the solver's own gain is returned (strictly stable); at decay 0.8 the rounded one."""
+    A, C = np.diag([-1.0, 0.5]), np.array([[0.0, 1.0]])
+    edge = synthesize_observer_gain(A, C, decay=0.0).L
+    assert edge[1, 0] > 0.5 and edge[1, 0] != round(edge[1, 0], 4)
+    inside = synthesize_observer_gain(A, C, decay=0.8).L
+    assert inside[1, 0] == float(f"{inside[1, 0]:.5g}") and inside[1, 0] > 1.3
 
 
 def test_synthesis_diagonal_optimum_is_the_frobenius_minimiser():

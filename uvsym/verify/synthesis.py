@@ -6,7 +6,12 @@ For ``e' = (A - L C) e`` a decay rate alpha holds with ``V = e^T P e`` when
 unknown-input observer's ``(P L) ... = ...`` conditions) enter as they are. The gain returned
 is ``L = P^-1 Y``, and the closed loop ``A - L C`` -- computed exactly in rationals from the doubles
 A, L and C, not the floating-point ``fl(A - L C)`` -- is re-certified by :func:`lyapunov_decrease`
-independently of the solver.
+independently of the solver. Without equality constraints L is first rounded to ``GAIN_DIGITS``
+significant digits of its largest entry: an interior-point solution's last digits move with the
+solver's build and the processor (observed: 4e-9 relative in a threshold derived from the gain), so
+the gain, every figure derived from it and the reports repeat across machines. The rounded gain is
+the one certified, or where rounding leaves too little margin (a rate at the edge of what the LMI
+reaches) the solver's own; with equalities (exact decoupling conditions) the solver's is kept.
 """
 
 from __future__ import annotations
@@ -22,9 +27,18 @@ from uvsym.verify.certificate import Certificate
 from uvsym.verify.exact import as_fraction_matrix, matmul
 from uvsym.verify.lyapunov import lyapunov_decrease
 
-__all__ = ["DESIGN_MARGIN", "GainSynthesis", "synthesize_observer_gain"]
+__all__ = ["DESIGN_MARGIN", "GAIN_DIGITS", "GainSynthesis", "synthesize_observer_gain"]
 
 DESIGN_MARGIN = 1.01  # the LMI asks for 1 % more than the rate certified
+GAIN_DIGITS = 5  # significant digits (of the largest entry) an unconstrained gain is rounded to
+
+
+def _rounded(L: np.ndarray) -> np.ndarray:
+    """L rounded to ``GAIN_DIGITS`` significant digits of its largest entry (a zero L as it is)."""
+    scale = float(np.max(np.abs(L))) if L.size else 0.0
+    if not scale > 0 or not np.isfinite(scale):
+        return L
+    return np.round(L, int(GAIN_DIGITS - 1 - np.floor(np.log10(scale)))) + 0.0  # no -0.0
 
 
 @dataclass(frozen=True)
@@ -78,11 +92,15 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
             break
     else:
         raise VerificationError(f"no observer gain with decay {decay} 1/s: the LMI at {' and at '.join(tried)}")
-    L = np.linalg.solve(P.value, Y.value)
-    L_exact = as_fraction_matrix(L, "L")
-    closed_loop = [[a - lc for a, lc in zip(row_a, row_lc)] for row_a, row_lc in zip(A_exact, matmul(L_exact, C_exact))]
-    certificate = lyapunov_decrease(claim, [closed_loop], decay,
-                                    f"A - L C (exact, in rationals) with the synthesised L, decay {decay:g} 1/s")
+    solved = np.linalg.solve(P.value, Y.value)
+    for L in ([solved] if equalities else [_rounded(solved), solved]):  # rounded where it certifies
+        L_exact = as_fraction_matrix(L, "L")
+        closed_loop = [[a - lc for a, lc in zip(row_a, row_lc)]
+                       for row_a, row_lc in zip(A_exact, matmul(L_exact, C_exact))]
+        certificate = lyapunov_decrease(claim, [closed_loop], decay,
+                                        f"A - L C (exact, in rationals) with the synthesised L, decay {decay:g} 1/s")
+        if certificate.status == "proved":
+            break
     if certificate.status != "proved":
         raise UvsymError(f"the synthesised gain could not be certified at decay {decay:g} 1/s "
                          f"({certificate.status}: {certificate.reason or certificate.method})")
