@@ -33,7 +33,8 @@ def Smtrx(a):
 
     Parameters
     ----------
-    a : (3,) vector
+    a : (3,) array
+        The vector a.
     """
     a1, a2, a3 = _entries(a, 3)
     return stack([[0.0, -a3, a2], [a3, 0.0, -a1], [-a2, a1, 0.0]])

@@ -74,9 +74,12 @@ def fixed_thrusters(alpha, horizontal_positions, vertical_positions) -> Actuator
 
     Parameters
     ----------
-    alpha : (k,) horizontal thrust angles from the x axis (rad)
-    horizontal_positions : (k, 3) positions of the horizontal thrusters from the CO (m)
-    vertical_positions : (m - k, 3) positions of the vertical thrusters (m)
+    alpha : (k,) array
+        Horizontal thrust angles from the x axis (rad).
+    horizontal_positions : (k, 3) array
+        Positions of the horizontal thrusters from the CO (m).
+    vertical_positions : (m - k, 3) array
+        Positions of the vertical thrusters (m).
     """
     alpha = np.atleast_1d(np.asarray(alpha, dtype=float))
     if not np.all(np.isfinite(alpha)):
@@ -99,10 +102,14 @@ def vectored_thrusters(theta_ex, theta_ez, positions, free_angles) -> ActuatorCo
 
     Parameters
     ----------
-    theta_ex, theta_ez : (n,) current azimuth (from x in the horizontal plane) and tilt
-        (from z) of each thrust vector (rad)
-    positions : (n, 3) thruster positions from the CO (m)
-    free_angles : (n,) each one of "none", "ex", "ez", "both": which angles are controllable
+    theta_ex : (n,) array
+        Current azimuth of each thrust vector, from x in the horizontal plane (rad).
+    theta_ez : (n,) array
+        Current tilt of each thrust vector, from z (rad).
+    positions : (n, 3) array
+        Thruster positions from the CO (m).
+    free_angles : (n,) sequence of str
+        Each one of "none", "ex", "ez", "both": which angles are controllable.
     """
     ex = np.atleast_1d(np.asarray(theta_ex, dtype=float))
     ez = np.atleast_1d(np.asarray(theta_ez, dtype=float))

@@ -19,9 +19,12 @@ def rigid_body_mass(m: float, I_g, r_bg) -> np.ndarray:
 
     Parameters
     ----------
-    m : mass (kg)
-    I_g : (3, 3) inertia dyadic about the CG (kg m^2)
-    r_bg : (3,) CG relative to the CO, body axes (m)
+    m : float
+        Mass (kg).
+    I_g : (3, 3) array
+        Inertia dyadic about the CG (kg m^2).
+    r_bg : (3,) array
+        CG relative to the CO, body axes (m).
     """
     M_cg = np.zeros((6, 6))
     M_cg[:3, :3] = m * np.eye(3)
@@ -39,8 +42,10 @@ def coriolis_from_mass(M, nu):
 
     Parameters
     ----------
-    M : (n, n) mass matrix, n = 6 or 3 (kg, kg m, kg m^2)
-    nu : (n,) velocity (m/s, rad/s), numeric or CasADi
+    M : (n, n) array
+        Mass matrix, n = 6 or 3 (kg, kg m, kg m^2).
+    nu : (n,) array or CasADi vector
+        Velocity (m/s, rad/s).
     """
     M = np.asarray(M, dtype=float)
     M = 0.5 * (M + M.T)
@@ -60,8 +65,14 @@ def coriolis_rigid_body_cg(m: float, I_g, r_bg, nu):
 
     Parameters
     ----------
-    m : mass (kg); I_g : (3, 3) inertia about the CG (kg m^2); r_bg : (3,) CG from CO (m)
-    nu : (6,) body velocity (m/s, rad/s), numeric or CasADi
+    m : float
+        Mass (kg).
+    I_g : (3, 3) array
+        Inertia about the CG (kg m^2).
+    r_bg : (3,) array
+        CG from the CO (m).
+    nu : (6,) array or CasADi vector
+        Body velocity (m/s, rad/s).
     """
     H = Hmtrx(r_bg)
     nu2 = nu[3:6]

@@ -44,9 +44,9 @@ class IsolationSettings:
     """window_s: fit and variance window (s); fit: exponential (eq. 19), line or quadratic (the
     polynomial whose value and slope at the window's end go into eqs. 22-24); threshold: variance
     bound (units of f squared);
-    margin: the winner's variance must be <= margin * every other's; healthy_tolerance: |f_bar| of
+    margin: the winner's variance must be <= margin * every other's; healthy_tolerance: ``|f_bar|`` of
     the bias observer (N, N m) below which a settled channel is healthy; healthy_tolerance_p:
-    |f_bar - 1| of the proportional observer likewise (-)."""
+    ``|f_bar - 1|`` of the proportional observer likewise (-)."""
 
     window_s: float = 1.0
     fit: str = "exponential"

@@ -7,7 +7,7 @@ its decided channels is faulty -- the channels' predicted faults give the delive
 ``tau_hat`` on those rows at the decision instant, ``u = u_e + B^+ (tau_hat - tau_d)`` the
 delivered actuator values (eq. 26, u_e what healthy actuators would deliver) and the fault's
 value follows; the fault kind is the one decided on the faulty channel where the actuator has the
-largest share of authority (|B_ia| times its range). An actuator all of whose channels are
+largest share of authority (``|B_ia|`` times its range). An actuator all of whose channels are
 decided healthy is healthy. With ``correct=True`` the command correction (divide by f_p,
 subtract f_a, stop and redistribute) goes back to the loop and acts from the next supervisor
 period on.

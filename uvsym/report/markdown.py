@@ -1,4 +1,4 @@
-"""Markdown pieces for reports (GitHub-flavoured, math in ``$$ ... $$``) and deterministic JSON."""
+"""Markdown pieces for reports (GitHub-flavoured, math between ``$$`` delimiters) and deterministic JSON."""
 
 from __future__ import annotations
 

@@ -53,26 +53,56 @@ def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float,
 
     Parameters
     ----------
-    eta0, nu0 : (dof,) initial position/attitude (m, rad) and velocity (m/s, rad/s).
-    actuators0 : (m,) initial actuator values; default: the first command (no start-up transient).
-    current : (V_c m/s, beta_c rad), or an (N + 1, 2) array with one row per sample.
-    observers : estimators (:class:`~uvsym.observers.base.Observer`, sampled every dt) run in the loop;
-        each reads measured states and ``tau_d.<force>`` by name and starts from ``init``.
-    supervisor : discrete logic run every ``supervisor.period`` s that may correct the commands.
-    method : ``fast`` (compiled fixed-step RK4 with ``substeps`` per sample) or a CasADi
-        integrator plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it,
-        over the defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
-    seed : seed of the standard normal draws behind sensor noise faults.
-    rk4_tolerance : the fast path's local error per sample, relative to each state's scale over the
-        run, checked by step doubling on sampled steps (:mod:`uvsym.sim.step_error`: an
-        IntegrationAccuracyWarning naming the substeps that would meet it; None: no check).
+    model : Model
+        The vehicle (:mod:`uvsym.models.model`).
+    controller : Autopilot
+        Guidance and control (:mod:`uvsym.sim.autopilot`).
+    duration : float
+        Length of the run (s).
+    dt : float
+        Sample time (s).
+    eta0 : (dof,) array
+        Initial position/attitude (m, rad).
+    nu0 : (dof,) array
+        Initial velocity (m/s, rad/s).
+    actuators0 : (m,) array or None
+        Initial actuator values; default: the first command (no start-up transient).
+    current : (2,) or (N + 1, 2) array
+        Current (V_c m/s, beta_c rad), constant or one row per sample.
+    actuator_faults : tuple of ActuatorFault
+        Faults on the actuators (:mod:`uvsym.faults`).
+    sensor_faults : tuple of SensorFault
+        Faults on the measured states.
+    observers : tuple of Observer
+        Estimators (:class:`~uvsym.observers.base.Observer`, sampled every dt) run in the loop; each
+        reads measured states and ``tau_d.<force>`` by name and starts from ``init``.
+    supervisor : Supervisor or None
+        Discrete logic run every ``supervisor.period`` s that may correct the commands.
+    method : str
+        ``fast`` (compiled fixed-step RK4, ``substeps`` per sample) or a CasADi integrator plugin
+        (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample.
+    substeps : int
+        RK4 steps per sample on the fast path.
+    seed : int
+        Seed of the standard normal draws behind sensor noise faults.
+    options : dict or None
+        Integrator options, over the defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
+    compiled : bool
+        Fast path compiled to C when a compiler is found (else interpreted by CasADi).
+    progress : callable or None
+        Called with the fraction of the run done (0 to 1) as it advances.
+    rk4_tolerance : float or None
+        The fast path's local error per sample, relative to each state's scale over the run, checked by
+        step doubling (:mod:`uvsym.sim.step_error`: an IntegrationAccuracyWarning naming the substeps
+        that would meet it); None: no check.
 
     Returns
     -------
-    SimResult with signals x (true state), y (measured), u_desired (controller), u_command (sent,
-    corrected and saturated), u_expected (what healthy actuators deliver), u_actual (delivered),
-    fault_actuator (u_actual - healthy), fault_sensor (y - x), tau_desired, reference and
-    f_hat/<observer>, one row per grid time ``0, dt, ..., duration``.
+    SimResult
+        Signals x (true state), y (measured), u_desired (controller), u_command (sent, corrected and
+        saturated), u_expected (what healthy actuators deliver), u_actual (delivered), fault_actuator
+        (u_actual - healthy), fault_sensor (y - x), tau_desired, reference and f_hat/<observer>, one
+        row per grid time ``0, dt, ..., duration``.
     """
     run = prepare_run(model, controller, duration=duration, dt=dt, eta0=eta0, nu0=nu0, actuators0=actuators0,
                       current=current, actuator_faults=actuator_faults, sensor_faults=sensor_faults,

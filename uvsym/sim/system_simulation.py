@@ -43,22 +43,52 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
 
     Parameters
     ----------
-    x0 : (n_x,) initial plant state (array or ``{name: value}``), in the states' units.
-    method : ``fast`` (compiled fixed-step RK4, ``substeps`` per sample) or a CasADi integrator
-        plugin (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample; ``options`` go to it, over the
-        defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
-    d : plant disturbances, constant (n_d,) or one row per sample (N + 1, n_d); default 0.
-    p : plant parameters (default ``plant.p0``); substitutions: channel -> substitute signal,
-        switched by the supervisor's ``Substitution`` decisions (all off at the start).
-    seed : seed of the standard normal draws behind sensor noise faults.
-    rk4_tolerance : the fast path's step-error tolerance (:func:`uvsym.sim.simulate`; None: no check).
+    plant : System
+        The plant, continuous or discrete (:mod:`uvsym.systems.system`).
+    blocks : sequence of Block
+        Controllers, estimators and logic (:mod:`uvsym.sim.blocks`), wired to the plant by signal name.
+    duration : float
+        Length of the run (s).
+    dt : float
+        Sample time (s).
+    x0 : (n_x,) array or dict
+        Initial plant state (or ``{name: value}``), in the states' units.
+    method : str
+        ``fast`` (compiled fixed-step RK4, ``substeps`` per sample) or a CasADi integrator plugin
+        (``cvodes``, ``idas``, ``rk``, ``collocation``) over each sample.
+    actuator_faults : tuple of ActuatorFault
+        Faults on the plant's inputs (:mod:`uvsym.faults`).
+    sensor_faults : tuple of SensorFault
+        Faults on its measured outputs.
+    substitutions : dict or None
+        Channel -> substitute signal, switched by the supervisor's ``Substitution`` decisions (all off
+        at the start).
+    supervisor : Supervisor or None
+        Discrete logic run every ``supervisor.period`` s.
+    d : (n_d,) or (N + 1, n_d) array or None
+        Plant disturbances, constant or one row per sample; default 0.
+    p : (n_p,) array or None
+        Plant parameters; default ``plant.p0``.
+    seed : int
+        Seed of the standard normal draws behind sensor noise faults.
+    substeps : int
+        RK4 steps per sample on the fast path.
+    options : dict or None
+        Integrator options, over the defaults of ``uvsym.sim.run.DEFAULT_OPTIONS``.
+    compiled : bool
+        Fast path compiled to C when a compiler is found (else interpreted by CasADi).
+    progress : callable or None
+        Called with the fraction of the run done (0 to 1) as it advances.
+    rk4_tolerance : float or None
+        The fast path's step-error tolerance (as in :func:`uvsym.sim.simulate`); None: no check.
 
     Returns
     -------
-    SimResult with one row per grid time ``0, dt, ..., duration``: x (true states), y (measured
-    outputs), u (plant inputs applied, after actuator faults), one group per block (what it
-    publishes, named by the block), fault_sensor (y - h(x, u)), fault_actuator (u - commanded)
-    and, with substitutions, substitution (each channel's switch, 0 or 1).
+    SimResult
+        One row per grid time ``0, dt, ..., duration``: x (true states), y (measured outputs), u (plant
+        inputs applied, after actuator faults), one group per block (what it publishes, named by the
+        block), fault_sensor (y - h(x, u)), fault_actuator (u - commanded) and, with substitutions,
+        substitution (each channel's switch, 0 or 1).
     """
     N = grid(duration, dt)
     for what, faults in (("actuator_faults", actuator_faults), ("sensor_faults", sensor_faults)):

@@ -5,8 +5,8 @@ generates C from) on intervals: each work variable holds (k,) lower and upper bo
 entry per box, so a batch of boxes costs one numpy operation per instruction. Every rounded
 operation moves its bounds outward by one unit in the last place (``numpy.nextafter``), overflow
 included (a bound that overflows to inf moves back to the largest double on the inner side);
-IEEE +, -, *, / and sqrt are correctly rounded, so that encloses the exact result; results
-that are exact anyway (sums whose TwoSum error is 0, 2 x without overflow, and 0 * x, 0 / x)
+IEEE ``+``, ``-``, ``*``, ``/`` and sqrt are correctly rounded, so that encloses the exact result; results
+that are exact anyway (sums whose TwoSum error is 0, 2 x without overflow, and ``0 * x``, ``0 / x``)
 stay unwidened, so that an equilibrium evaluates to exactly 0. Integer powers go by repeated
 squaring of intervals (each step outward-rounded). Library functions (exp, sin, tanh, ...) are
 accurate to within an ulp or two; they are widened by ``LIBM_ULPS`` units, except where their

@@ -21,12 +21,14 @@ LIBM_ULPS = 4
 
 
 def round_down(x, ulps: int = 1):
+    """x moved ``ulps`` floats towards -inf (array or float)."""
     for _ in range(ulps):
         x = np.nextafter(x, -np.inf)
     return x
 
 
 def round_up(x, ulps: int = 1):
+    """x moved ``ulps`` floats towards +inf (array or float)."""
     for _ in range(ulps):
         x = np.nextafter(x, np.inf)
     return x
@@ -38,6 +40,7 @@ def clean(lo, hi):
 
 
 def is_zero(a):
+    """Per box: the interval ``a`` = (lo, hi) is exactly [0, 0]."""
     return (a[0] == 0) & (a[1] == 0)
 
 
@@ -115,6 +118,7 @@ def mul(a, b):
 
 
 def holds_zero(b):
+    """Per box: the interval ``b`` = (lo, hi) contains 0."""
     return (b[0] <= 0.0) & (b[1] >= 0.0)
 
 
@@ -140,6 +144,8 @@ def even(a, function):
 
 
 def increasing(function, ulps: int = LIBM_ULPS):
+    """Interval extension of an increasing ``function``: its endpoint values widened by ``ulps`` floats
+    (the libm error bound)."""
     def apply(a):
         with np.errstate(all="ignore"):
             return clean(round_down(function(a[0]), ulps), round_up(function(a[1]), ulps))
@@ -174,6 +180,8 @@ def indicator(true, false):
 
 
 def compare(op, a, b):
+    """Interval of the 0/1 result of CasADi comparison ``op`` (<, <=, ==, !=) on intervals a and b, and
+    whether it is undecided per box (:func:`indicator`)."""
     if op == ca.OP_LT:
         return indicator(a[1] < b[0], a[0] >= b[1])
     if op == ca.OP_LE:
@@ -186,6 +194,7 @@ def compare(op, a, b):
 
 
 def square(a):
+    """a^2: an even function, 0 kept exact, bounds rounded outward."""
     lo, hi = even(a, np.square)
     return exact_zeros(clean(round_down(lo), round_up(hi)), a)
 
