@@ -1,21 +1,46 @@
-"""Sphinx configuration of uvsym's documentation (``sphinx-build -W -b html docs OUT``)."""
+"""Sphinx configuration of uvsym's documentation (``sphinx-build -W -b html docs OUT``).
+
+The API reference is generated from the package (one page per module, autosummary), the gallery
+from ``examples/*.py`` (sphinx-gallery, each script run by the build)."""
 
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+DOCS = Path(__file__).resolve().parent
+sys.path[:0] = [str(DOCS.parent), str(DOCS)]  # uvsym, and gallery_figures for the gallery's hooks
 
 project = "uvsym"
 author = "The uvsym developers"
 copyright = "2026, The uvsym developers"  # noqa: A001 (Sphinx's name)
-extensions = ["sphinx.ext.autodoc", "sphinx.ext.napoleon", "myst_parser"]  # napoleon reads the NumPy-style sections
+extensions = ["sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon", "myst_parser",
+              "sphinx_gallery.gen_gallery"]
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 master_doc = "index"
 exclude_patterns = ["_build"]
+templates_path = ["_templates"]
 myst_enable_extensions = ["dollarmath"]
 myst_heading_anchors = 3
+
+autosummary_generate = True  # api/uvsym.*.rst, one page per module, rewritten by every build
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
+autodoc_default_options = {"members": True}  # the names of each module's __all__
 napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+napoleon_use_param = True  # one field per parameter: "name (type) -- description"
+napoleon_use_rtype = False  # a Returns section's text stays one paragraph
+
+sphinx_gallery_conf = {
+    "examples_dirs": str(DOCS.parent / "examples"),
+    "gallery_dirs": "gallery",
+    "filename_pattern": r"\.py$",  # every script is run, and its output shown
+    "run_stale_examples": True,  # run by every build, never an earlier build's output
+    "reset_argv": "gallery_figures.output_folder",
+    "image_scrapers": ("gallery_figures.written_figures", "matplotlib"),
+    "download_all_examples": False,
+    "write_computation_times": False,
+    "capture_repr": (),  # the printed output only, not the value of a script's last line
+    "remove_config_comments": True,
+}
+
 html_theme = "alabaster"

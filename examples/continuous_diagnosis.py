@@ -1,10 +1,13 @@
-"""uvsym's continuous actuator diagnosis on faults the shipped experiment does not have.
+"""Continuous actuator diagnosis
+=============================
+
+uvsym's continuous actuator diagnosis on faults the shipped experiment does not have.
 
 Starts from the shipped ``docking_diagnosis`` scenario, replaces its faults with a rudder stuck at
 0.1 rad from 6 s and an intermittent thruster bias of 8 N (on 4 s of every 10 s from 12 s), adds
 surge-speed sensor noise that the diagnosis is told about, runs it without correction and prints
-the decision log, then writes it as JSON (the schema of ``uvsym simulate --events``) into a folder
-of your choice (default: a temporary one).
+the decision log, then writes it as JSON (the schema of ``uvsym simulate --events``) and a figure of
+the run (faults' onsets dashed, alarms dotted) into a folder of your choice (default: a temporary one).
 
 Run: python examples/continuous_diagnosis.py [OUTPUT_FOLDER]
 """
@@ -36,3 +39,4 @@ for e in result.events:
 out.mkdir(parents=True, exist_ok=True)
 log = write_events(result.events, out / "events.json")
 print(f"wrote {log}")
+result.plot(out / "diagnosis.svg")

@@ -1,4 +1,7 @@
-"""The shipped docking scenario with a thruster bias and a rudder fault, varied: a larger rudder fault.
+"""Docking with actuator faults
+============================
+
+The shipped docking scenario with a thruster bias and a rudder fault, varied: a larger rudder fault.
 
 Loads the scenario, changes the proportional factor of both rudders (upper and lower, 0.8 as
 shipped) to 0.5, simulates with the compiled fast path, prints the observers' converged estimates

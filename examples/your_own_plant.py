@@ -1,11 +1,20 @@
-"""Your own plant, observer and sensor fault, with no code of uvsym's changed.
+"""Your own plant, observer and sensor fault
+=========================================
+
+Your own plant, observer and sensor fault, with no code of uvsym's changed.
 
 A mass-spring-damper written as a System (named signals with units), a Luenberger observer whose
 gain is synthesised by LMI and certified in exact arithmetic, a PID position loop, and a position
-sensor that reads 0.1 m too much from 2 s on. Prints when the residual first exceeds a threshold.
+sensor that reads 0.1 m too much from 2 s on. Prints when the residual first exceeds a threshold
+and draws the run (states, force, the observer's residual) into a folder of your choice (default: a
+temporary one).
 
-Run: python examples/your_own_plant.py
+Run: python examples/your_own_plant.py [OUTPUT_FOLDER]
 """
+
+import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
@@ -15,6 +24,7 @@ from uvsym.sim import observer_block, pid, simulate_system
 from uvsym.systems import signals, system
 from uvsym.verify import synthesize_observer_gain
 
+out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp())
 MASS, SPRING, DAMPING = 2.0, 8.0, 1.5  # kg, N/m, N s/m
 
 plant = system(
@@ -40,3 +50,4 @@ threshold = 0.02  # m
 alarm = result.t[np.argmax(residual > threshold)] if (residual > threshold).any() else None
 print(f"true position at 5 s: {result['x']['pos'][-1]:.3f} m; residual alarm at t = {alarm} s")
 assert alarm is not None and 2.0 <= alarm < 3.0, alarm
+result.plot(out / "mass_spring.svg")

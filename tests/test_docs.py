@@ -3,6 +3,8 @@ warning, and the README cites every paper exactly as derivations/papers.py does.
 
 from __future__ import annotations
 
+import inspect
+import pkgutil
 import re
 import runpy
 import sys
@@ -10,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+import uvsym
 from derivations.papers import PAPERS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,6 +50,7 @@ def test_every_example_runs(example, tmp_path, monkeypatch, capsys):
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:The mapping interface for autodoc options")  # Sphinx's own
+@pytest.mark.filterwarnings("ignore:'sphinx.environment.BuildEnvironment.app' is deprecated")  # myst's include
 def test_sphinx_builds_the_documentation_without_a_warning(tmp_path, capsys, monkeypatch):  # napoleon, Sphinx 9
     pytest.importorskip("sphinx", reason="sphinx is in the test extra: pip install -e '.[test]'")
     pytest.importorskip("myst_parser", reason="myst-parser is in the test extra")
@@ -60,9 +64,18 @@ def test_sphinx_builds_the_documentation_without_a_warning(tmp_path, capsys, mon
     monkeypatch.setattr(logging.getLogger("sphinx"), "handlers", list(logging.getLogger("sphinx").handlers))
     status = build_main(["-W", "--keep-going", "-q", "-b", "html", str(ROOT / "docs"), str(tmp_path / "html")])
     assert status == 0, capsys.readouterr().err[-6000:]
-    page = (tmp_path / "html" / "api.html").read_text()
-    assert "synthesize_observer_gain" in page or "linearisation_claim" in page
-    assert (tmp_path / "html" / "tutorial.html").exists()
+    html = tmp_path / "html"
+    assert (html / "tutorial.html").exists()
+    modules = [m.name for m in pkgutil.walk_packages(uvsym.__path__, "uvsym.")]
+    missing = [m for m in ["uvsym", *modules] if not (html / "api" / f"{m}.html").exists()]
+    assert len(modules) > 100 and not missing, f"modules without an API page: {missing}"
+    page = (html / "api" / "uvsym.sim.system_simulation.html").read_text()
+    entry = page.split('id="uvsym.sim.system_simulation.simulate_system"')[1].split('id="uvsym.sim.')[0]
+    from uvsym.sim.system_simulation import simulate_system
+    assert re.findall(r"<strong>(\w+)</strong>", entry) == list(inspect.signature(simulate_system).parameters)
+    for example in EXAMPLES:  # the gallery: every script, run, with what it printed and the figure it wrote
+        shown = (html / "gallery" / f"{example.stem}.html").read_text()
+        assert "sphx-glr-script-out" in shown and re.search(r'<img[^>]+src="[^"]+_001\.svg"', shown), example.name
 
 
 def test_readme_scenario_schema_is_the_validators():
