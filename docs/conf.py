@@ -24,7 +24,28 @@ myst_heading_anchors = 3
 autosummary_generate = True  # api/uvsym.*.rst, one page per module, rewritten by every build
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
-autodoc_default_options = {"members": True}  # the names of each module's __all__
+autodoc_default_options = {"members": True, "undoc-members": True}  # the names of each module's __all__
+
+
+def _constants() -> dict[str, list[tuple[str, bool]]]:
+    """Per module, the names of its ``__all__`` that are not classes, functions or modules, each with
+    whether its value is too long to print (repr over 120 characters): autodoc documents module
+    data only with a doc comment, so the module template lists these by autodata."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import uvsym
+
+    found = {}
+    for info in pkgutil.walk_packages(uvsym.__path__, "uvsym."):
+        module = importlib.import_module(info.name)
+        found[info.name] = [(name, len(repr(obj)) > 120) for name in getattr(module, "__all__", ()) if not (
+            inspect.isclass(obj := getattr(module, name)) or callable(obj) or inspect.ismodule(obj))]
+    return found
+
+
+autosummary_context = {"constants": _constants()}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_use_param = True  # one field per parameter: "name (type) -- description"
@@ -44,3 +65,15 @@ sphinx_gallery_conf = {
 }
 
 html_theme = "alabaster"
+
+
+def _drop_type_docstrings(app, what, name, obj, options, lines):
+    """A constant without a doc comment gets its type's docstring (dict's, str's) from autodata: none."""
+    import inspect
+
+    if what == "data" and lines and "\n".join(lines).strip() == (inspect.getdoc(type(obj)) or "").strip():
+        lines.clear()
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _drop_type_docstrings)

@@ -3,6 +3,7 @@ warning, and the README cites every paper exactly as derivations/papers.py does.
 
 from __future__ import annotations
 
+import importlib
 import inspect
 import pkgutil
 import re
@@ -69,6 +70,14 @@ def test_sphinx_builds_the_documentation_without_a_warning(tmp_path, capsys, mon
     modules = [m.name for m in pkgutil.walk_packages(uvsym.__path__, "uvsym.")]
     missing = [m for m in ["uvsym", *modules] if not (html / "api" / f"{m}.html").exists()]
     assert len(modules) > 100 and not missing, f"modules without an API page: {missing}"
+    undocumented = []  # every name of a module's __all__ (a package's are documented where they are defined)
+    for name in modules:
+        module = importlib.import_module(name)
+        if not hasattr(module, "__path__"):
+            page = (html / "api" / f"{name}.html").read_text()
+            undocumented += [f"{name}.{n}" for n in getattr(module, "__all__", ())
+                             if not inspect.ismodule(getattr(module, n)) and f'id="{name}.{n}"' not in page]
+    assert not undocumented, f"public names missing from the API reference: {undocumented}"
     page = (html / "api" / "uvsym.sim.system_simulation.html").read_text()
     entry = page.split('id="uvsym.sim.system_simulation.simulate_system"')[1].split('id="uvsym.sim.')[0]
     from uvsym.sim.system_simulation import simulate_system
