@@ -49,6 +49,12 @@ def test_every_example_runs(example, tmp_path, monkeypatch, capsys):
     assert capsys.readouterr().out.strip(), "an example says what it found"
 
 
+
+def test_the_api_page_sorts_every_top_level_module_by_subject():
+    page = (ROOT / "docs" / "api.md").read_text()
+    listed = re.findall(r"^   (uvsym\.\w+)$", page[page.index("## By subject"):], re.M)
+    assert sorted(listed) == sorted(f"uvsym.{m.name}" for m in pkgutil.iter_modules(uvsym.__path__))
+
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:The mapping interface for autodoc options")  # Sphinx's own
 @pytest.mark.filterwarnings("ignore:'sphinx.environment.BuildEnvironment.app' is deprecated")  # myst's include

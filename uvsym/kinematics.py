@@ -1,4 +1,4 @@
-"""Rigid-body kinematics in Fossen's notation (Fossen 2021, ch. 2), generic over types.
+"""Rigid-body kinematics in Fossen's notation (Fossen 2021, chapter 2), generic over types.
 
 Every function accepts Python floats, numpy arrays, or CasADi ``SX``/``MX``/``DM`` and
 returns the matching kind: a numpy array for numeric input, a CasADi matrix when any
