@@ -9,9 +9,10 @@ With ``V = sum_i e_i^T P_i e_i`` and ``Y_i = P_i K_i`` the decay ``V' <= -2 alph
 
 (the paper's Phi blocks; one block of size n is the usual observer LMI). Outcomes:
 
-- **proved**: the solver's P, K are rounded to rationals and ``P_i > 0``,
-  ``-(He(P A_cl) + 2 alpha P) > 0`` for ``A_cl = Omega - blkdiag(K_i C_i)`` are shown by exact
-  LDL^T; the gains are returned.
+- **proved**: the solver's P, K -- rounded to ``GAIN_DIGITS`` significant digits where they still
+  pass, so that gains and margins repeat across machines (:func:`~uvsym.verify.synthesis.rounded_gain`)
+  -- are taken as rationals and ``P_i > 0``, ``-(He(P A_cl) + 2 alpha P) > 0`` for
+  ``A_cl = Omega - blkdiag(K_i C_i)`` are shown by exact LDL^T; the gains are returned.
 - **refuted**: a dual certificate ``Z = Z^T >= 0``, ``Z != 0`` with ``C_i Z_ii = 0`` and every
   diagonal block ``S_i = [Omega Z + Z Omega^T + 2 alpha Z]_ii >= 0``, all checked in exact
   rationals. It excludes every P, Y: else ``Q = He(P Omega - Y C) + 2 alpha P < 0`` would give
@@ -39,7 +40,7 @@ import sympy
 from uvsym.errors import VerificationError as LMIError
 from uvsym.verify.certificate import Certificate
 from uvsym.verify.lyapunov import exact_positive_definite
-from uvsym.verify.synthesis import DESIGN_MARGIN
+from uvsym.verify.synthesis import DESIGN_MARGIN, rounded_gain
 
 __all__ = ["BlockGains", "BlockLMI", "block_lmi", "block_lmi_claim", "dual_certificate",
            "exact_positive_semidefinite", "solve_block_lmi"]
@@ -333,8 +334,10 @@ def solve_block_lmi(problem: BlockLMI, claim: str = "block LMI", set_description
         solution = _solve(problem, rate, D)
         if solution is None:
             continue
-        P, K = solution
-        ok, margin = _exact_check(problem, P, K)
+        for P, K in (([rounded_gain(p) for p in solution[0]], [rounded_gain(k) for k in solution[1]]), solution):
+            ok, margin = _exact_check(problem, P, K)  # rounded (repeats across machines) where it passes
+            if ok:
+                break
         if ok:
             method = f"{solved}; its P and K re-checked by exact rational LDL^T (margin: the smallest pivot)"
             certificate = Certificate(claim, where, method, "proved", expected, margin=float(margin),

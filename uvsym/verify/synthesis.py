@@ -27,14 +27,15 @@ from uvsym.verify.certificate import Certificate
 from uvsym.verify.exact import as_fraction_matrix, matmul
 from uvsym.verify.lyapunov import lyapunov_decrease
 
-__all__ = ["DESIGN_MARGIN", "GAIN_DIGITS", "GainSynthesis", "synthesize_observer_gain"]
+__all__ = ["DESIGN_MARGIN", "GAIN_DIGITS", "GainSynthesis", "rounded_gain", "synthesize_observer_gain"]
 
 DESIGN_MARGIN = 1.01  # the LMI asks for 1 % more than the rate certified
-GAIN_DIGITS = 5  # significant digits (of the largest entry) an unconstrained gain is rounded to
+GAIN_DIGITS = 5  # significant digits (of the largest entry) a solver's gain is rounded to
 
 
-def _rounded(L: np.ndarray) -> np.ndarray:
-    """L rounded to ``GAIN_DIGITS`` significant digits of its largest entry (a zero L as it is)."""
+def rounded_gain(L: np.ndarray) -> np.ndarray:
+    """L (any shape) rounded to ``GAIN_DIGITS`` significant digits of its largest entry (a zero L as it is):
+    what an interior-point solver's answer is certified as, so that it repeats across machines."""
     scale = float(np.max(np.abs(L))) if L.size else 0.0
     if not scale > 0 or not np.isfinite(scale):
         return L
@@ -93,7 +94,7 @@ def synthesize_observer_gain(A, C, decay: float, equalities: list | None = None,
     else:
         raise VerificationError(f"no observer gain with decay {decay} 1/s: the LMI at {' and at '.join(tried)}")
     solved = np.linalg.solve(P.value, Y.value)
-    for L in ([solved] if equalities else [_rounded(solved), solved]):  # rounded where it certifies
+    for L in ([solved] if equalities else [rounded_gain(solved), solved]):  # rounded where it certifies
         L_exact = as_fraction_matrix(L, "L")
         closed_loop = [[a - lc for a, lc in zip(row_a, row_lc)]
                        for row_a, row_lc in zip(A_exact, matmul(L_exact, C_exact))]
