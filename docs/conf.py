@@ -3,11 +3,14 @@
 The API reference is generated from the package (one page per module, autosummary), the gallery
 from ``examples/*.py`` (sphinx-gallery, each script run by the build)."""
 
+import shutil
 import sys
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 sys.path[:0] = [str(DOCS.parent), str(DOCS)]  # uvsym, and gallery_figures for the gallery's hooks
+for generated in ("api", "gallery"):  # written afresh by every build: a page of a removed module or example
+    shutil.rmtree(DOCS / generated, ignore_errors=True)  # left behind would be a page in no toctree (-W)
 
 project = "uvsym"
 author = "The uvsym developers"
