@@ -5,8 +5,8 @@
 
 int main(void) {
   int i, rc;
-  static const uvsym_induction_motor_real s[5] = {0.011768942830484963, 30.07036774334313, 0.0004541335020886907, 0.2780464283442053,
-    250.00121722927477};
+  static const uvsym_induction_motor_real s[5] = {0.011770831346064797, 30.070271785538704, 0.00045160434956889367, 0.27804477368840563,
+    250.00121737829662};
   static const uvsym_induction_motor_real y[3] = {0.008484252354150196, 29.94674925715017, 249.99996234140758};
   static const uvsym_induction_motor_real u[2] = {143.23944878999998, 0.8999999999999999};
   const uvsym_induction_motor_real* p = NULL;
