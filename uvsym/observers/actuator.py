@@ -150,17 +150,29 @@ def _fault_action(fault: ActuatorKind, T_d, tau_d) -> tuple:
 
 
 def proportional_observer(model: Model, form: str = "paper") -> ca.Function:
-    """Theorem 1 (eqs. 2, 12-13): ``x(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the proportional factors."""
+    """Theorem 1 (eqs. 2, 12-13): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the proportional factors.
+
+    The CasADi Function alone: ``actuator_observer(model, "proportional", form).function`` (that object also
+    carries the error dynamics and what design_gains needs).
+    """
     return actuator_observer(model, "proportional", form).function
 
 
 def bias_observer(model: Model, form: str = "paper") -> ca.Function:
-    """Theorem 2 (eqs. 3, 14-15): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the biases (N, N m)."""
+    """Theorem 2 (eqs. 3, 14-15): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the biases (N, N m).
+
+    The CasADi Function alone: ``actuator_observer(model, "bias", form).function`` (that object also
+    carries the error dynamics and what design_gains needs).
+    """
     return actuator_observer(model, "bias", form).function
 
 
 def constant_observer(model: Model, form: str = "paper") -> ca.Function:
-    """Theorem 3 (eqs. 4, 16-17): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the delivered forces."""
+    """Theorem 3 (eqs. 4, 16-17): ``(x, eta, nu, tau_d, K) -> (x_dot, f_hat)``, f the delivered forces.
+
+    The CasADi Function alone: ``actuator_observer(model, "constant", form).function`` (that object also
+    carries the error dynamics and what design_gains needs).
+    """
     return actuator_observer(model, "constant", form).function
 
 
