@@ -65,3 +65,17 @@ def test_every_field_of_every_shipped_scenario_refuses_bad_values_by_name(capsys
               ", ".join(f"{cls} {result} {n}" for (cls, result), n in sorted(counts.items())))
     assert sum(counts.values()) > 2000  # the suite really ran over the shipped files
     assert not failures, "\n".join(failures)
+
+
+def test_a_misspelt_key_is_named_when_its_table_fails_for_another_reason():
+    """A campaign that sets ``blocks[0].valuesx`` leaves the file's own values (one row) beside two times: the
+    shape error comes first, and names the misspelling that caused it."""
+    path = ROOT / "derivations/motor_luenberger/scenarios/motor_luenberger_step.toml"
+    table = tomllib.loads(path.read_text())
+    table["blocks"][0] |= {"times": [0.0, 1.0], "valuesx": [[1.0, 2.0], [3.0, 4.0]]}
+    result, message = outcome(functools.partial(parse_any_scenario, root=str(path.parent)), table)
+    assert result == "typed" and "one row of 2 value(s) per time" in message
+    assert message.endswith("(is 'blocks[0].valuesx' a misspelt 'values'?)")
+    table["blocks"][0] = {**table["blocks"][0], "values": [[1.0, 2.0], [3.0, 4.0]]}  # both given: unknown field
+    result, message = outcome(functools.partial(parse_any_scenario, root=str(path.parent)), table)
+    assert result == "typed" and "valuesx: unknown field (did you mean 'values'?)" in message

@@ -307,9 +307,9 @@ def _build(fields: Fields, plant: System, dt: float, kind: str | None = None) ->
     name = fields.text("name", kind)
     try:
         built = BLOCKS[kind](fields, plant, dt, name)
-    except ScenarioError:
-        raise
+    except ScenarioError as exc:
+        raise ScenarioError(f"{exc}{fields.unread_hint()}") from None
     except UvsymError as exc:
-        raise ScenarioError(f"{fields.path} ({kind} {name!r}): {exc}") from None
+        raise ScenarioError(f"{fields.path} ({kind} {name!r}): {exc}{fields.unread_hint()}") from None
     fields.done()
     return built

@@ -43,6 +43,15 @@ class Fields:
         near = difflib.get_close_matches(key, [str(k) for k in self.data if k != key], n=1, cutoff=0.75)
         return f" (is {near[0]!r} a misspelt {key!r}?)" if near else ""
 
+    def unread_hint(self) -> str:
+        """`` (is 'timesx' a misspelt 'times'?)`` for a key not read so far that is close to one read: added to
+        an error raised while the table was being read, whose cause may be the misspelling."""
+        for key in sorted(map(str, set(self.data) - self.used)):
+            near = difflib.get_close_matches(key, sorted(self.used), n=1, cutoff=0.75)
+            if near:
+                return f" (is {self._name(key)!r} a misspelt {near[0]!r}?)"
+        return ""
+
     def has(self, key: str) -> bool:
         return key in self.data
 

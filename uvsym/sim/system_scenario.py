@@ -484,10 +484,10 @@ def _detector(fields: Fields, scenario_loop: WiredLoop, z0: np.ndarray, w0: np.n
     name = fields.label("name", kind)
     try:
         detector = DETECTORS[kind](fields, name, scenario_loop, z0, w0, step)
-    except ScenarioError:
-        raise
+    except ScenarioError as exc:
+        raise ScenarioError(f"{exc}{fields.unread_hint()}") from None
     except UvsymError as exc:
-        raise ScenarioError(f"{fields.path} ({name}): {exc}") from None
+        raise ScenarioError(f"{fields.path} ({name}): {exc}{fields.unread_hint()}") from None
     fields.done()
     return detector
 
