@@ -86,6 +86,12 @@ def _doubled(plant_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
     return ca.Function("doubled", [s, u, env, t], [coarse, fine])
 
 
+@memoized(16)
+def _mapped(doubled: ca.Function) -> ca.Function:
+    """``doubled`` over ``CHECKS`` steps at once, one per column."""
+    return doubled.map(CHECKS)
+
+
 def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> StepError | None:
     """The largest error of the checked steps of a finished run (module docstring): outputs (N + 1, n_out)
     its logged rows, W (N + 1, n_w) its inputs. None for a discrete-time plant, a loop that cannot read its
@@ -101,12 +107,17 @@ def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> St
     faulty = loop.logged(outputs, "fault_actuator") != 0
     ks = check_indices(U, np.any(faulty[1:] != faulty[:-1], axis=1) if faulty.shape[1] else None)
     worst = (0.0, 0.0, 0)
-    for k in ks:
-        coarse, fine = (np.asarray(v).ravel() for v in doubled(S[k], U[k], W[k, loop.env_columns], W[k, 0]))
-        ratio = np.abs(coarse - fine) * (16.0 / 15.0) / scale
-        i = int(np.argmax(ratio))
-        if np.isfinite(ratio[i]) and ratio[i] > worst[0]:
-            worst = (float(ratio[i]), float(W[k, 0]), i)
+    if ks:  # every checked step in one call of the map over CHECKS steps (the last one repeated to fill it)
+        rows = ks + ks[-1:] * (CHECKS - len(ks))
+        steps = _mapped(doubled)(S[rows].T, U[rows].T, W[rows][:, loop.env_columns].T, W[rows, 0][None, :])
+        coarse, fine = (np.asarray(v).T[:len(ks)] for v in steps)
+        ratio = np.abs(coarse - fine) * (16.0 / 15.0) / scale  # (checked, entries)
+        entries = np.argmax(ratio, axis=1)
+        largest = ratio[np.arange(len(ks)), entries]
+        valid = np.flatnonzero(np.isfinite(largest) & (largest > 0))  # a step with a non-finite entry says nothing
+        if valid.size:
+            j = int(valid[np.argmax(largest[valid])])
+            worst = (float(largest[j]), float(W[ks[j], 0]), int(entries[j]))
     ratio, t_s, entry = worst
     needed = loop.substeps if ratio <= 1.0 else math.ceil(loop.substeps * ratio ** 0.25)
     return StepError(ratio, t_s, entry, needed, len(ks))
