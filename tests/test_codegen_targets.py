@@ -154,3 +154,25 @@ def test_the_host_target_runs_natively(built):
     made, out, manifest = built("motor-luenberger", "host", "double")
     assert manifest["target"]["functions"]["luenberger_step"]["difference"] <= DOUBLE_ULPS
     assert manifest["target"]["functions"]["luenberger_step"]["instructions"] is None  # no emulator to count them
+
+
+def test_cppchecks_time_limit_is_the_callers_and_keys_its_memo(tmp_path):
+    """A limit too short for any analysis says it timed out after that limit; a long one analyses the same
+    sources (the memo keeps the two apart); the CLI refuses --analysis-seconds without --target or <= 0."""
+    import shutil
+
+    from uvsym.cli import main
+    from uvsym.codegen.target_run import _cppcheck
+
+    if shutil.which("cppcheck") is None:
+        pytest.skip("cppcheck not installed (scripts/install-arm-toolchain.sh installs it)")
+    (tmp_path / "src").mkdir()
+    (tmp_path / "include").mkdir()
+    (tmp_path / "src" / "p_casadi.c").write_text("int p_twice(int x) { return 2 * x; }\n")
+    (tmp_path / "src" / "p.c").write_text("int p_twice(int x);\nint p_four(int x) { return p_twice(p_twice(x)); }\n")
+    quick = _cppcheck(tmp_path, "p", 1e-4)
+    assert quick["timed_out_s"] == 1e-4 and quick["findings"] == [] and quick["misra"] is None
+    full = _cppcheck(tmp_path, "p", 60.0)
+    assert full["timed_out_s"] is None and full["findings"] == []
+    for bad in (["--analysis-seconds", "10"], ["--target", "host", "--analysis-seconds", "0"]):
+        assert main(["codegen", "motor-luenberger", "-o", str(tmp_path / "out"), *bad]) != 0

@@ -328,11 +328,14 @@ def _cmd_codegen(args) -> int:
                              built=make_products(observers.package_name)), "the C package")
     if args.budget and not args.target:
         raise UvsymError(f"uvsym codegen {args.name}: --budget needs --target")
+    if args.analysis_seconds is not None and (not args.target or not args.analysis_seconds > 0):
+        raise UvsymError(f"uvsym codegen {args.name}: --analysis-seconds needs --target and a positive number of "
+                         f"seconds, got {args.analysis_seconds:g}")
     from uvsym.codegen.target_run import parse_budget
 
     budget = parse_budget(args.budget or "")
     manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check,
-                               target=args.target, budget=budget)
+                               target=args.target, budget=budget, analysis_seconds=args.analysis_seconds)
     count = len(manifest["functions"])
     print(f"wrote {args.out}: {observers.package_name}, {count} function{'s' if count != 1 else ''} "
           f"({', '.join(f['c_function'] for f in manifest['functions'])}), {manifest['precision']}; "
@@ -553,6 +556,9 @@ def _parser() -> argparse.ArgumentParser:
                               "run it (qemu for Cortex-M) and record flash, RAM, stack, instructions per call")
     codegen.add_argument("--budget", help="with --target: refuse the package beyond these figures, e.g. "
                                           "flash=65536,ram=16384,stack=5120,instructions=50000")
+    codegen.add_argument("--analysis-seconds", type=float, metavar="S",
+                         help="with --target: cppcheck's time limit (default 30 s; a large generated step such as "
+                              "the UKF bank's needs about 150 s, or its manifest says it was not analysed)")
     codegen.set_defaults(run=_cmd_codegen)
     campaign = sub.add_parser("campaign", help="run a campaign file: scenarios over grids and Monte Carlo draws, "
                                                "on local processes or Dask; results, summary and report; resumable")

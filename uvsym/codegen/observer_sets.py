@@ -48,7 +48,7 @@ class ObserverSet:
 
     def write(self, out_dir, precision: str = "double", finite_check: bool = True,
               float_tolerance: float = FLOAT_TOLERANCE, target: str | None = None,
-              budget: dict[str, int] | None = None) -> dict:
+              budget: dict[str, int] | None = None, analysis_seconds: float | None = None) -> dict:
         """Write the C package into ``out_dir`` (:func:`uvsym.codegen.package.write_package`); the manifest.
 
         A float package is first run against double precision on the set's example
@@ -60,7 +60,8 @@ class ObserverSet:
         for it in a scratch folder (:func:`uvsym.codegen.target_run.run_target`), its figures and
         its distance from Python go into the manifest (``target``) and README, what its harness printed
         into ``target/harness.out``, and a figure beyond
-        ``budget`` (flash, ram, stack, instructions) refuses the package with BudgetError.
+        ``budget`` (flash, ram, stack, instructions) refuses the package with BudgetError;
+        ``analysis_seconds``: cppcheck's time limit on the target build (None: ``CPPCHECK_SECONDS``).
         """
         extra = {}
         if precision == "float":
@@ -76,21 +77,24 @@ class ObserverSet:
         chosen = printed = None
         if target is not None:
             chosen = targets.target(target)
-            extra["target"], printed = self._measure_target(chosen, precision, finite_check, budget or {})
+            extra["target"], printed = self._measure_target(chosen, precision, finite_check, budget or {},
+                                                            analysis_seconds)
         return write_package(out_dir, list(self.exported), self.package_name, precision, self.description,
                              citation=self.citation, example=self.example, finite_check=finite_check, extra=extra,
                              target=chosen, target_output=printed)
 
-    def _measure_target(self, chosen, precision: str, finite_check: bool, budget: dict[str, int]) -> tuple[dict, str]:
+    def _measure_target(self, chosen, precision: str, finite_check: bool, budget: dict[str, int],
+                        analysis_seconds: float | None) -> tuple[dict, str]:
         """The target figures of this set's package (``write``), checked against ``budget``, and what its
         harness printed."""
-        from uvsym.codegen.target_run import check_budget, differences, run_target
+        from uvsym.codegen.target_run import CPPCHECK_SECONDS, check_budget, differences, run_target
 
         with tempfile.TemporaryDirectory(prefix="uvsym-target-") as scratch:
             functions = list(self.exported)
             write_package(scratch, functions, self.package_name, precision, finite_check=finite_check,
                           example=self.example, target=chosen)
-            run = run_target(scratch, functions, self.package_name, precision, chosen)
+            run = run_target(scratch, functions, self.package_name, precision, chosen,
+                             CPPCHECK_SECONDS if analysis_seconds is None else analysis_seconds)
         figures = run.figures
         vectors = targets.target_vectors(functions, self.example)
         for name, difference in differences(functions, vectors, run, precision).items():

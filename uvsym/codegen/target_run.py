@@ -142,29 +142,30 @@ def _stack_bound(function: str, frames, edges) -> tuple[int | None, str, list[st
         return None, str(why), sorted(external)
 
 
-_CPPCHECKED: dict[bytes, dict] = {}  # sources' digest -> result: one analysis per source, whatever the target
+_CPPCHECKED: dict[tuple, dict] = {}  # (sources' digest, time limit) -> result: one analysis per source, any target
 
 
-def _cppcheck(package_dir: Path, name: str) -> dict | None:
-    """cppcheck's default checks on the package sources: its version and findings (None: not installed)."""
+def _cppcheck(package_dir: Path, name: str, seconds: float) -> dict | None:
+    """cppcheck's default checks on the package sources within ``seconds``: its version and findings
+    (None: not installed)."""
     if shutil.which("cppcheck") is None:
         return None
     sources = [f"src/{name}_casadi.c", f"src/{name}.c"]
-    digest = hashlib.sha256(b"".join((package_dir / s).read_bytes() for s in sources)).digest()
-    if digest not in _CPPCHECKED:
-        _CPPCHECKED[digest] = _run_cppcheck(package_dir, sources)
-    return dict(_CPPCHECKED[digest])
+    key = (hashlib.sha256(b"".join((package_dir / s).read_bytes() for s in sources)).digest(), seconds)
+    if key not in _CPPCHECKED:
+        _CPPCHECKED[key] = _run_cppcheck(package_dir, sources, seconds)
+    return dict(_CPPCHECKED[key])
 
 
-def _run_cppcheck(package_dir: Path, sources: list[str]) -> dict:
+def _run_cppcheck(package_dir: Path, sources: list[str], seconds: float = CPPCHECK_SECONDS) -> dict:
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
     try:
         done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1", "--addon=misra",
                                "--template={file}:{line}: {severity}: {message} [{id}]", "-Iinclude",
                                *sources], cwd=package_dir,
-                              capture_output=True, text=True, timeout=CPPCHECK_SECONDS)
+                              capture_output=True, text=True, timeout=seconds)
     except subprocess.TimeoutExpired:  # its value-flow analysis of a large generated source can take many minutes
-        return {"version": version, "findings": [], "misra": None, "timed_out_s": CPPCHECK_SECONDS}
+        return {"version": version, "findings": [], "misra": None, "timed_out_s": seconds}
     lines = [line for line in done.stderr.splitlines() if re.match(r".+:\d+: (?!information)\w+: ", line)]
     rules = Counter(m.group(1) for m in (re.search(r"\[misra-c2012-([\d.]+)\]$", line) for line in lines) if m)
     failed = re.search(r"Failed to execute [^\n]*", done.stderr)
@@ -185,8 +186,10 @@ def _decode(hexes: list[str], precision: str) -> np.ndarray:
     return np.array([struct.unpack(code, int(h, 16).to_bytes(width, "little"))[0] for h in hexes], dtype=float)
 
 
-def run_target(package_dir, functions, name: str, precision: str, chosen: Target) -> TargetRun:
-    """Build, check and run the target harness of the package in ``package_dir`` (module docstring).
+def run_target(package_dir, functions, name: str, precision: str, chosen: Target,
+               analysis_seconds: float = CPPCHECK_SECONDS) -> TargetRun:
+    """Build, check and run the target harness of the package in ``package_dir`` (module docstring);
+    ``analysis_seconds``: cppcheck's time limit (s).
 
     Raises CodegenError when a tool is missing, the package does not compile cleanly, it needs an
     allocating or I/O symbol of the C library, or the harness fails."""
@@ -242,7 +245,7 @@ def run_target(package_dir, functions, name: str, precision: str, chosen: Target
     figures = {"target": chosen.name, "description": chosen.description, "compiler": version,
                "flags": list(target_cflags(chosen)), "qemu_machine": chosen.machine, "clock_mhz": chosen.clock_mhz,
                "precision": precision, "flash": flash, "ram": ram, "library_symbols": needed,
-               "functions": described, "cppcheck": _cppcheck(package_dir, name)}
+               "functions": described, "cppcheck": _cppcheck(package_dir, name, analysis_seconds)}
     shutil.rmtree(build, ignore_errors=True)
     return TargetRun(figures, outputs, codes, "\n".join(lines) + "\n")
 
