@@ -27,7 +27,18 @@ def test_a_campaign_worker_and_the_simulator_start_without_the_heavy_libraries_a
     assert run.stdout.splitlines() == ["", ""]
 
 
-@pytest.mark.parametrize("package", ["uvsym.observers", "uvsym.report"])
+def test_uvsym_simulate_of_a_docking_run_imports_no_scipy_at_all():
+    """The docking run (vehicle, controller, two observers, compiled loop, event log) needs none of scipy: its
+    linalg, optimize, special, io and signal imports are where they are used (each 0.1-0.14 s of every call)."""
+    code = ("import sys\nfrom uvsym.cli import main\nassert main(['simulate', 'docking_faults']) == 0\n"
+            "print(' '.join(sorted(m for m in sys.modules if m.split('.')[0] in ('scipy', 'sympy', 'matplotlib', "
+            "'cvxpy'))))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.splitlines()[-1] == ""
+
+
+@pytest.mark.parametrize("package", ["uvsym.observers", "uvsym.report", "uvsym.diagnosis"])
 def test_every_exported_name_is_its_submodules_object_and_dir_lists_it(package):
     module = importlib.import_module(package)
     for name, submodule in module._EXPORTS.items():

@@ -5,8 +5,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from scipy.special import chdtri
-
 from uvsym.errors import DiagnosisError
 from uvsym.faults import ACTUATOR_KINDS
 
@@ -87,12 +85,19 @@ class DiagnosisSettings:
 
     def detection_threshold(self, hypotheses: int) -> float:
         """GLR above which a window alarms: chi2(1) quantile at false_alarm_rate / hypotheses."""
-        return float(chdtri(1, self.false_alarm_rate / max(hypotheses, 1)))
+        return _chi2_1_above(self.false_alarm_rate / max(hypotheses, 1))
 
     @property
     def isolation_margin(self) -> float:
         """GLR lead (noise variances) the best hypothesis needs over every rival."""
-        return float(chdtri(1, self.isolation_error_rate))
+        return _chi2_1_above(self.isolation_error_rate)
+
+
+def _chi2_1_above(probability: float) -> float:
+    """x with P(chi2(1) > x) = probability."""
+    from scipy.special import chdtri  # here: scipy.special costs every uvsym command about 0.1 s
+
+    return float(chdtri(1, probability))
 
 
 def _distinct_kinds(kinds) -> None:

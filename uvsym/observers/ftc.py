@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from uvsym.errors import IdentifiabilityError
 from uvsym.faults import actuator_kind
@@ -74,6 +73,8 @@ def corrected_commands(u_d, faults: dict[str, ActuatorFaultEstimate], labels: tu
     forces; a stopped actuator is commanded exactly 0. A fault's shift (a bias) also narrows the
     command's bounds so that the command plus the shift stays within them.
     """
+    from scipy.optimize import lsq_linear  # here: scipy.optimize costs every uvsym command about 0.1 s
+
     u_d = np.asarray(u_d, dtype=float)
     linear = linear_correction(faults, labels, B)
     u_lin = linear.S @ u_d + linear.o

@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 
 from uvsym.errors import FileFormatError, PathError, SimulationError, UnknownNameError
 from uvsym.paths import output_file
@@ -159,7 +158,7 @@ class SimResult:
         except OSError as exc:
             raise PathError(f"cannot read {path}: {exc.strerror or exc}") from None
         except (ValueError, KeyError, IndexError, TypeError, AttributeError, zipfile.BadZipFile,
-                NotImplementedError, scipy.io.matlab.MatReadError, SimulationError) as exc:
+                NotImplementedError, SimulationError) as exc:
             raise FileFormatError(f"{path} is not a result file uvsym wrote ({type(exc).__name__}: {exc})") from None
 
     def plot(self, path=None, names: tuple[str, ...] | None = None, overwrite: bool = False):
@@ -278,11 +277,18 @@ def _write_mat(result: SimResult, path: Path, layout: list, compress: bool) -> N
     layout = [{**item, "key": key} for item, key in zip(layout, keys)]
     content = {"t": result.t, "meta": json.dumps(result.meta), "layout": json.dumps(layout)}
     content |= {key: sig.values for key, sig in zip(keys, result.signals.values())}
+    import scipy.io  # here: importing it costs every uvsym command about 0.1 s
+
     scipy.io.savemat(path, content, do_compression=compress)
 
 
 def _read_mat(path: Path):
-    data = scipy.io.loadmat(path, simplify_cells=True)
+    import scipy.io
+
+    try:
+        data = scipy.io.loadmat(path, simplify_cells=True)
+    except scipy.io.matlab.MatReadError as exc:  # not a MATLAB file: the caller's format error
+        raise ValueError(str(exc)) from None
     layout = json.loads(data["layout"])
     return (np.asarray(data["t"], dtype=float).reshape(-1), [data[item["key"]] for item in layout],
             json.loads(data["meta"]), layout)

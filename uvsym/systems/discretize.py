@@ -14,7 +14,6 @@ from dataclasses import replace
 
 import casadi as ca
 import numpy as np
-from scipy.linalg import expm
 
 from uvsym.errors import ModelError
 from uvsym.numbers import real
@@ -33,6 +32,8 @@ def zoh_matrices(A, B, dt: float) -> tuple[np.ndarray, np.ndarray]:
     n, m = A.shape[0], B.shape[1]
     augmented = np.zeros((n + m, n + m))
     augmented[:n, :n], augmented[:n, n:] = A, B
+    from scipy.linalg import expm  # here: scipy.linalg costs every uvsym command about 0.13 s
+
     phi = expm(dt * augmented)
     return phi[:n, :n], phi[:n, n:]
 
