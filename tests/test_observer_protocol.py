@@ -393,3 +393,45 @@ def test_run_goes_in_fixed_chunks_with_the_numbers_of_one_step_after_another(mon
         np.testing.assert_array_equal(S[k + 1], s_next)
         np.testing.assert_array_equal(OUT[k], out)
         s = s_next
+
+
+def test_run_compiled_gives_the_steps_numbers_and_is_the_default_for_long_records(monkeypatch):
+    """compiled=True rolls the step in C (IEEE flags): the states and outputs of one step after another to
+    rounding, S's first row the initial state; from COMPILE_FROM samples it is the default, unless Y has NaN to
+    skip (missing_y: the virtual machine keeps NaN's semantics); without a compiler compiled=True raises."""
+    import numpy as np
+    from problems import double_integrator
+
+    from uvsym.codegen.compile import find_compiler
+    from uvsym.errors import CodegenError
+    from uvsym.observers import base
+    from uvsym.observers.ukf import ukf
+
+    if find_compiler() is None:
+        pytest.skip("no C compiler")
+    obs = ukf(double_integrator(outputs=("pos",)), dt=0.1, Q=np.diag([1e-6, 1e-4]), R=1e-4, P0=np.eye(2))
+    N = 300
+    Y, U = np.random.default_rng(2).normal(scale=0.01, size=(N, 1)), np.zeros((N, 1))
+    S_vm, OUT_vm = obs.run(Y, U, compiled=False)
+    S_c, OUT_c = obs.run(Y, U, compiled=True)
+    assert S_c.shape == S_vm.shape and OUT_c.shape == OUT_vm.shape
+    np.testing.assert_array_equal(S_c[0], S_vm[0])
+    np.testing.assert_allclose(S_c, S_vm, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(OUT_c, OUT_vm, rtol=1e-12, atol=1e-15)
+    chosen = []
+    compiled_roll = base._compiled_roll
+    monkeypatch.setattr(base, "_compiled_roll", lambda step, required: chosen.append(required)
+                        or compiled_roll(step, required))
+    monkeypatch.setattr(base, "COMPILE_FROM", 200)
+    obs.run(Y, U)                      # 300 >= 200: compiled by default
+    obs.run(Y[:100], U[:100])          # shorter: the virtual machine
+    gaps = Y.copy()
+    gaps[5] = np.nan
+    obs.run(gaps, U, missing_y=True)   # NaN to skip: the virtual machine
+    assert chosen == [False]
+    monkeypatch.setattr(base, "_compiled_roll", compiled_roll)
+    monkeypatch.setattr("uvsym.codegen.compile.find_compiler", lambda: None)
+    fresh = ukf(double_integrator(outputs=("pos",)), dt=0.2, Q=np.diag([1e-6, 1e-4]), R=1e-4, P0=np.eye(2))
+    with pytest.raises(CodegenError, match="no C compiler"):
+        fresh.run(Y, U, compiled=True)
+    assert fresh.run(Y, U)[0].shape == (N + 1, fresh.state.size)  # the default falls back to the virtual machine

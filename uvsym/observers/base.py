@@ -129,11 +129,16 @@ class Observer:
                                 f" expected {self.state.size} finite")
         return s0
 
-    def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False,
+            compiled: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out)).
 
         missing_y: Y may hold NaN (an estimator that skips the update of such a sample, e.g. a
         Kalman filter); the initial state is then taken from the first complete measurement.
+        compiled: the steps in a compiled C loop (:func:`uvsym.codegen.compile.compile_roll`, IEEE flags:
+        the numbers of CasADi's evaluation to rounding) rather than CasADi's virtual machine; None: from
+        ``COMPILE_FROM`` samples on when a C compiler is found and Y has no NaN to skip (a first call
+        compiles, about a second, kept in the compile cache).
         """
         Y, U = np.atleast_2d(np.asarray(Y, dtype=float)), np.atleast_2d(np.asarray(U, dtype=float))
         if Y.shape[1] != self.reads_y.size or U.shape[1] != self.reads_u.size or len(Y) != len(U) or len(Y) == 0:
@@ -150,6 +155,16 @@ class Observer:
             np.asarray(s0, dtype=float).reshape(-1)
         if s.size != self.state.size or not np.all(np.isfinite(s)):
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
+        roll = None
+        if compiled or (compiled is None and len(Y) >= COMPILE_FROM and not missing_y):
+            roll = _compiled_roll(self.step, required=bool(compiled))
+        if roll is not None:  # one buffer of rows [out; s]: S and OUT are views of it, nothing copied
+            W = np.ascontiguousarray(np.column_stack([Y, U, np.broadcast_to(p, (len(Y), p.size))]))
+            n_out = self.publishes.size
+            rows = np.empty((len(Y) + 1, n_out + self.state.size))
+            rows[0, :n_out], rows[0, n_out:] = np.nan, s
+            roll(s, W, rows[1:])
+            return rows[:, n_out:], rows[1:, :n_out]
         states, outputs = [s[None, :]], []
         for start in range(0, len(Y), RUN_CHUNK):  # fixed chunks: the cost is linear in N (one mapaccum(N) is not)
             k = min(RUN_CHUNK, len(Y) - start)
@@ -160,6 +175,25 @@ class Observer:
 
 
 RUN_CHUNK = 2048  # samples per mapaccum call of Observer.run
+COMPILE_FROM = 5000  # samples from which Observer.run compiles its steps by default
+
+
+@memoized(32)
+def _compiled_roll(step: ca.Function, required: bool):
+    """``roll(s0, W, rows)`` of ``step`` in C (W's rows [y; u; p], each row of ``rows`` [out; s_next]); None
+    without a compiler unless ``required`` (then CodegenError)."""
+    from uvsym.codegen.compile import DEFAULT_FLAGS, compile_roll
+    from uvsym.errors import CodegenError
+
+    s, y, u, p = (ca.SX.sym(name, step.size1_in(i)) for i, name in enumerate(STEP_INPUTS))
+    s_next, out = step(s, y, u, p)
+    rolled = ca.Function(f"{step.name()}_run", [s, ca.vertcat(y, u, p)], [s_next, ca.vertcat(out, s_next)])
+    try:
+        return compile_roll(rolled, DEFAULT_FLAGS)
+    except CodegenError:
+        if required:
+            raise
+        return None
 
 
 @memoized(32)
