@@ -5,6 +5,7 @@ errors. Expected values are the injected faults (by construction) or closed-form
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -218,7 +219,9 @@ def test_cli_writes_the_decision_log(tmp_path, capsys):
     scenario_file.write_text(text)
     out = tmp_path / "events.json"
     assert main(["simulate", str(scenario_file), "--events", str(out)]) == 0
-    assert "faults standing at the end: X bias" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "faults standing at the end: X bias" in printed
+    assert re.search(r"X bias 1[23](\.\d+)? \+- [\d.e-]+ \(2 std\) \((identified|isolated) at", printed), printed
     log = json.loads(out.read_text())
     assert [e["event"] for e in log][:2] == ["detected", "isolated"]
     assert all(set(e) == {"t", "event", "target", "kind", "value", "detector", "std"} for e in log)

@@ -233,7 +233,8 @@ def _decisions(events: list[dict]) -> str:
             standing[e["target"]] = e
         elif e["event"] == "cleared":
             standing.pop(e["target"], None)
-    faults = ", ".join(f"{a} {e['kind']} {e['value']:.4g} ({e['event']} at {e['t']:g} s)" for a, e in standing.items())
+    faults = ", ".join(f"{a} {e['kind']} {e['value']:.4g}" + (f" +- {2 * e['std']:.2g} (2 std)" if e.get("std") else "")
+                       + f" ({e['event']} at {e['t']:g} s)" for a, e in standing.items())
     return f"diagnosis: {len(events)} events; faults standing at the end: {faults or 'none'}"
 
 
