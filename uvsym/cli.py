@@ -309,6 +309,14 @@ def _cmd_codegen(args) -> int:
         return 0
     if not args.out:
         raise UvsymError(f"uvsym codegen {args.name}: give the output folder with -o/--out DIR")
+    if args.budget and not args.target:
+        raise UvsymError(f"uvsym codegen {args.name}: --budget needs --target")
+    if args.analysis_seconds is not None and (not args.target or not args.analysis_seconds > 0):
+        raise UvsymError(f"uvsym codegen {args.name}: --analysis-seconds needs --target and a positive number of "
+                         f"seconds, got {args.analysis_seconds:g}")
+    from uvsym.codegen.target_run import parse_budget  # the options checked before anything is built
+
+    budget = parse_budget(args.budget or "")
     if _is_scenario_file(args.name):
         from uvsym.scenario_exports import scenario_package
 
@@ -327,14 +335,6 @@ def _cmd_codegen(args) -> int:
 
     make_folder(claim_folder(args.out, "the C package", "package", args.force,
                              built=make_products(observers.package_name)), "the C package")
-    if args.budget and not args.target:
-        raise UvsymError(f"uvsym codegen {args.name}: --budget needs --target")
-    if args.analysis_seconds is not None and (not args.target or not args.analysis_seconds > 0):
-        raise UvsymError(f"uvsym codegen {args.name}: --analysis-seconds needs --target and a positive number of "
-                         f"seconds, got {args.analysis_seconds:g}")
-    from uvsym.codegen.target_run import parse_budget
-
-    budget = parse_budget(args.budget or "")
     manifest = observers.write(args.out, "float" if args.float else "double", finite_check=not args.no_finite_check,
                                target=args.target, budget=budget, analysis_seconds=args.analysis_seconds)
     count = len(manifest["functions"])

@@ -87,14 +87,13 @@ class ObserverSet:
                         analysis_seconds: float | None) -> tuple[dict, str]:
         """The target figures of this set's package (``write``), checked against ``budget``, and what its
         harness printed."""
-        from uvsym.codegen.target_run import CPPCHECK_SECONDS, check_budget, differences, run_target
+        from uvsym.codegen.target_run import check_budget, differences, run_target
 
         with tempfile.TemporaryDirectory(prefix="uvsym-target-") as scratch:
             functions = list(self.exported)
             write_package(scratch, functions, self.package_name, precision, finite_check=finite_check,
                           example=self.example, target=chosen)
-            run = run_target(scratch, functions, self.package_name, precision, chosen,
-                             CPPCHECK_SECONDS if analysis_seconds is None else analysis_seconds)
+            run = run_target(scratch, functions, self.package_name, precision, chosen, analysis_seconds)
         figures = run.figures
         vectors = targets.target_vectors(functions, self.example)
         for name, difference in differences(functions, vectors, run, precision).items():

@@ -157,7 +157,7 @@ def _cppcheck(package_dir: Path, name: str, seconds: float) -> dict | None:
     return dict(_CPPCHECKED[key])
 
 
-def _run_cppcheck(package_dir: Path, sources: list[str], seconds: float = CPPCHECK_SECONDS) -> dict:
+def _run_cppcheck(package_dir: Path, sources: list[str], seconds: float) -> dict:
     version = subprocess.run(["cppcheck", "--version"], capture_output=True, text=True).stdout.strip()
     try:
         done = subprocess.run(["cppcheck", "--std=c99", "--quiet", "--max-configs=1", "--addon=misra",
@@ -187,9 +187,9 @@ def _decode(hexes: list[str], precision: str) -> np.ndarray:
 
 
 def run_target(package_dir, functions, name: str, precision: str, chosen: Target,
-               analysis_seconds: float = CPPCHECK_SECONDS) -> TargetRun:
+               analysis_seconds: float | None = None) -> TargetRun:
     """Build, check and run the target harness of the package in ``package_dir`` (module docstring);
-    ``analysis_seconds``: cppcheck's time limit (s).
+    ``analysis_seconds``: cppcheck's time limit (s; None: ``CPPCHECK_SECONDS``).
 
     Raises CodegenError when a tool is missing, the package does not compile cleanly, it needs an
     allocating or I/O symbol of the C library, or the harness fails."""
@@ -242,10 +242,11 @@ def run_target(package_dir, functions, name: str, precision: str, chosen: Target
         outputs[f] = np.array([_decode(r[4:], precision) for r in got])
         codes[f] = np.array([int(r[1]) for r in got])
     version = _run([tools["gcc"], "--version"], package_dir, "gcc --version").splitlines()[0]
+    seconds = CPPCHECK_SECONDS if analysis_seconds is None else analysis_seconds
     figures = {"target": chosen.name, "description": chosen.description, "compiler": version,
                "flags": list(target_cflags(chosen)), "qemu_machine": chosen.machine, "clock_mhz": chosen.clock_mhz,
                "precision": precision, "flash": flash, "ram": ram, "library_symbols": needed,
-               "functions": described, "cppcheck": _cppcheck(package_dir, name, analysis_seconds)}
+               "functions": described, "cppcheck": _cppcheck(package_dir, name, seconds)}
     shutil.rmtree(build, ignore_errors=True)
     return TargetRun(figures, outputs, codes, "\n".join(lines) + "\n")
 

@@ -25,6 +25,7 @@ correction (:func:`uvsym.observers.ftc.linear_correction`) from the next decisio
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -368,6 +369,7 @@ class ActuatorDiagnosis:
         first = max(0, min(self._episode - self.W + 1, k - self.W_iso + 1))
         rows = np.arange(first, k + 1)
 
+        @functools.cache  # the coarse best is looked at again in the fine search
         def misfit(onset: int) -> float:
             fit = self._fit(rows, [Hypothesis(lead.actuator, lead.kind, onset)])
             J = float(fit.J_model - fit.glr[0])

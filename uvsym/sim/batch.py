@@ -46,9 +46,10 @@ LANES = 4  # trajectories per compiled step on AVX2 and AVX-512 processors (see 
 def default_lanes() -> int:
     """Trajectories per compiled step on this processor: one vector of doubles, at most ``LANES``.
 
-    On AVX-512 (8 doubles) the docking loop's lanes measured slower at 8 than at 4 (256 against 220 ns
-    per trajectory-step, 10,000 steps, benchmarks/campaign.py): its steps stream about 1.1 KB of inputs
-    and outputs each, and the wider step waits on memory; a processor with 2 doubles per vector gets 2.
+    On AVX-512 (8 doubles) the docking loop's compiled lanes measured slower at 8 than at 4 (256 against
+    220 ns per trajectory-step over 10,000 steps, ``benchmarks/campaign.py`` times 4, 8 and 16): its steps
+    stream about 1.1 KB of inputs and outputs each, and the wider step waits on memory; a processor with
+    2 doubles per vector gets 2.
     """
     return min(vector_doubles(), LANES)
 

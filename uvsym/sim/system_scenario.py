@@ -278,8 +278,8 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
         fields.describe("signal", "string", "one of the plant's disturbances")
         signal = fields.text("signal", choices=plant.d.names)
         given = fields.data.get("times")
-        times = fields.vector("times", len(given) if isinstance(given, list) else -1)
-        if times is None or not times.size or np.any(np.diff(times) <= 0):
+        times = fields.vector("times", len(given)) if isinstance(given, list) and given else None
+        if times is None or np.any(np.diff(times) <= 0):
             raise ScenarioError(f"{fields.path}.times: expected strictly increasing times (s), one per value, "
                                 f"got {given!r}")
         values = fields.vector("values", times.size)
