@@ -488,3 +488,40 @@ def test_error_dynamics_claims_keep_the_expected_status_and_the_stated_symbols()
     assert sorted(point) == sorted(f"{name}_{i}" for name in ("e", "f", "eta", "nu", "tau_d", "K") for i in range(2))
     # the difference of the two sides, -K e, is nonzero at the counterexample
     assert max(abs(point["K_0"] * point["e_0"]), abs(point["K_1"] * point["e_1"])) > 0
+
+
+@pytest.mark.parametrize("kind", ["bias", "constant", "proportional"])
+def test_the_any_plant_derivation_is_the_vehicles_own_with_its_matrices_put_in(kind):
+    """The free-symbol derivation behind the any-plant proofs, evaluated at the docking AUV's M^-1 and h,
+    gives the vehicle's own error dynamics at random points (so the proof is about the same observer)."""
+    from uvsym import vehicle
+    from uvsym.observers.actuator import actuator_observer, any_plant_error_dynamics
+
+    model = vehicle("docking_auv")
+    own = actuator_observer(model, kind, "paper", require_assumption_1=False)
+    d = any_plant_error_dynamics(kind, "paper", 6)
+    put_in = ca.substitute([d["e_dot"], d["A"]], [d["M_inv"], d["h"]],
+                           [ca.DM(np.linalg.inv(model.M)), model.h(d["eta"], d["nu"])])
+    names = ("e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K")
+    generic = ca.Function("generic", [d[v] for v in names], put_in)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        point = [rng.normal(size=6) for _ in names]
+        e_dot, A = generic(*point)
+        assert np.allclose(np.asarray(e_dot).ravel(), np.asarray(own.error_dynamics(*point)).ravel(), rtol=1e-9,
+                           atol=1e-9)
+        assert np.allclose(np.asarray(A), np.asarray(own.error_matrix(point[4], point[6])), rtol=1e-12, atol=1e-12)
+
+
+def test_the_any_plant_claim_refutes_a_wrong_closed_form_and_the_graph_claims_say_why_they_are_not_proved(claims):
+    from uvsym.observers.actuator import any_plant_error_dynamics
+
+    d = any_plant_error_dynamics("bias", "paper", 2)
+    inputs = [d[v] for v in ("e", "f", "eta", "nu", "tau_d", "K", "h")] + [ca.vec(d["M_inv"])]
+    wrong = prove_identity("missing M^-1", ca.substitute(d["e_dot"], d["tau_d_dot"], ca.DM.zeros(2)),
+                           ca.mtimes(ca.jacobian(d["R"], d["nu"]), d["e"]), [ca.vertcat(*inputs)], "all", "refuted")
+    assert wrong.status == "refuted"
+    graph = [c for c in claims if "docking_auv" in c.claim and c.expected == "checked"]
+    assert len(graph) == 2 and all("no exact proof of this graph exists" in c.method for c in graph)
+    any_plant = [c for c in claims if "any plant of 6 DOF" in c.claim]
+    assert [c.status for c in any_plant] == ["proved"] * 3

@@ -37,8 +37,8 @@ from uvsym.errors import ObserverError
 from uvsym.faults import ActuatorKind, actuator_kind
 from uvsym.models.model import Model
 
-__all__ = ["KINDS", "FORMS", "ActuatorObserver", "actuator_observer", "proportional_observer", "bias_observer",
-           "constant_observer", "init_state"]
+__all__ = ["KINDS", "FORMS", "ActuatorObserver", "actuator_observer", "any_plant_error_dynamics",
+           "proportional_observer", "bias_observer", "constant_observer", "init_state"]
 
 KINDS = ("proportional", "bias", "constant")
 FORMS = ("paper", "momentum")
@@ -93,29 +93,11 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
                             "(Assumption 1: CG = CB, symmetric vehicle); use form='momentum'")
     n = model.dof
     M_inv = ca.DM(np.linalg.inv(M))
-    P = M_inv if form == "paper" else ca.DM(M)
-    x, eta, nu = ca.SX.sym("x", n), ca.SX.sym("eta", n), ca.SX.sym("nu", n)
-    tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
-    T_d, K_mat = ca.diag(tau_d), ca.diag(K)
-
-    G, b, identity = _fault_action(actuator_kind(kind), T_d, tau_d)
-    gain = P if identity else (ca.mtimes(P, G) if form == "paper" else ca.mtimes(G, P))
-    R = -ca.mtimes(K_mat, ca.mtimes(gain, nu))
-    L = ca.jacobian(R, nu)
-    h = model.h(eta, nu)
-    LM = ca.mtimes(L, M_inv)
-    x_dot = ca.mtimes(LM, ca.mtimes(G, x) - ca.mtimes(G, R) - h + b)
-    f_hat = x - R
-
+    d = _derivation(kind, form, M_inv, M_inv if form == "paper" else ca.DM(M), model.h)
+    x, eta, nu, tau_d, K, e, f, tau_d_dot = (d[v] for v in ("x", "eta", "nu", "tau_d", "K", "e", "f", "tau_d_dot"))
+    x_dot, f_hat, R, L, e_dot, A = (d[v] for v in ("x_dot", "f_hat", "R", "L", "e_dot", "A"))
     names = ["x", "eta", "nu", "tau_d", "K"]
     function = ca.Function(f"{kind}_observer", [x, eta, nu, tau_d, K], [x_dot, f_hat], names, ["x_dot", "f_hat"])
-    # Exact error dynamics: with f constant, x = f - e + R(nu, tau_d) and the faulty plant
-    # M nu' = G f + b - h, e' = -x' + L nu' + (dR/dtau_d) tau_d'. A = L M^-1 G when tau_d' = 0.
-    e, f, tau_d_dot = ca.SX.sym("e", n), ca.SX.sym("f", n), ca.SX.sym("tau_d_dot", n)
-    plant_nu_dot = ca.mtimes(M_inv, ca.mtimes(G, f) + b - h)
-    e_dot = (-ca.substitute(x_dot, x, f - e + R) + ca.mtimes(L, plant_nu_dot)
-             + ca.mtimes(ca.jacobian(R, tau_d), tau_d_dot))
-    A = ca.mtimes(LM, G)
     forces = FORCE_LABELS[n]
     labels = {"x": forces, "eta": POSITION_LABELS[n], "nu": VELOCITY_LABELS[n], "tau_d": forces, "K": forces,
               "x_dot": forces, "f_hat": forces, "e": forces, "f": forces, "tau_d_dot": forces, "e_dot": forces}
@@ -131,6 +113,43 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
         error_dynamics=check(ca.Function("e_dot", [e, f, eta, nu, tau_d, tau_d_dot, K], [e_dot],
                                          ["e", "f", "eta", "nu", "tau_d", "tau_d_dot", "K"], ["e_dot"])),
     )
+
+
+def _derivation(kind: str, form: str, M_inv, P, h) -> dict[str, ca.SX]:
+    """The observer's symbols and expressions (module docstring): ``M_inv`` (n x n) and ``P`` (the
+    form's gain matrix, ``M^-1`` or ``M``) constant or symbolic, ``h(eta, nu)`` (n) the plant's
+    forces. Exact error dynamics: with f constant, ``x = f - e + R(nu, tau_d)`` and the faulty plant
+    ``M nu' = G f + b - h``, ``e' = -x' + L nu' + (dR/dtau_d) tau_d'``; ``A = L M^-1 G`` when tau_d' = 0."""
+    n = M_inv.size1()
+    x, eta, nu = ca.SX.sym("x", n), ca.SX.sym("eta", n), ca.SX.sym("nu", n)
+    tau_d, K = ca.SX.sym("tau_d", n), ca.SX.sym("K", n)
+    T_d, K_mat = ca.diag(tau_d), ca.diag(K)
+    G, b, identity = _fault_action(actuator_kind(kind), T_d, tau_d)
+    gain = P if identity else (ca.mtimes(P, G) if form == "paper" else ca.mtimes(G, P))
+    R = -ca.mtimes(K_mat, ca.mtimes(gain, nu))
+    L = ca.jacobian(R, nu)
+    forces = h(eta, nu)
+    LM = ca.mtimes(L, M_inv)
+    x_dot = ca.mtimes(LM, ca.mtimes(G, x) - ca.mtimes(G, R) - forces + b)
+    e, f, tau_d_dot = ca.SX.sym("e", n), ca.SX.sym("f", n), ca.SX.sym("tau_d_dot", n)
+    plant_nu_dot = ca.mtimes(M_inv, ca.mtimes(G, f) + b - forces)
+    e_dot = (-ca.substitute(x_dot, x, f - e + R) + ca.mtimes(L, plant_nu_dot)
+             + ca.mtimes(ca.jacobian(R, tau_d), tau_d_dot))
+    return {"x": x, "eta": eta, "nu": nu, "tau_d": tau_d, "K": K, "e": e, "f": f, "tau_d_dot": tau_d_dot,
+            "x_dot": x_dot, "f_hat": x - R, "R": R, "L": L, "e_dot": e_dot, "A": ca.mtimes(LM, G)}
+
+
+def any_plant_error_dynamics(kind: str, form: str, n: int) -> dict[str, ca.SX]:
+    """:func:`actuator_observer`'s derivation for every plant of n degrees of freedom at once:
+    ``M^-1`` (symbols ``M_inv``, n x n), the momentum form's ``M`` (symbols ``M``) and
+    ``h(eta, nu)`` (symbols ``h``, n) are free symbols, so an identity of its ``e_dot`` holds for
+    any mass matrix and any forces, in exact arithmetic (no double constant is folded). Keys as
+    :func:`_derivation`'s, plus ``M_inv``, ``M`` and ``h``."""
+    if kind not in KINDS or form not in FORMS:
+        raise ObserverError(f"unknown observer kind {kind!r} or form {form!r}; known: {KINDS}, {FORMS}")
+    M_inv, M, h = ca.SX.sym("M_inv", n, n), ca.SX.sym("M", n, n), ca.SX.sym("h", n)
+    d = _derivation(kind, form, M_inv, M_inv if form == "paper" else M, lambda eta, nu: h)
+    return {**d, "M_inv": M_inv, "M": M, "h": h}
 
 
 def _fault_action(fault: ActuatorKind, T_d, tau_d) -> tuple:

@@ -15,12 +15,12 @@ import itertools
 import casadi as ca
 import numpy as np
 
-from uvsym.observers.actuator import ActuatorObserver
+from uvsym.observers.actuator import ActuatorObserver, any_plant_error_dynamics
 from uvsym.verify.certificate import Certificate
 from uvsym.verify.identity import prove_identity
 from uvsym.verify.lyapunov import lyapunov_decrease
 
-__all__ = ["error_dynamics_claim", "convergence_claim"]
+__all__ = ["error_dynamics_claim", "any_plant_error_dynamics_claim", "convergence_claim"]
 
 
 def _label(name: str, observer: ActuatorObserver) -> str:
@@ -42,6 +42,21 @@ def error_dynamics_claim(name: str, observer: ActuatorObserver, constant_tau_d: 
     varying = "" if constant_tau_d else " also while tau_d varies"
     return prove_identity(f"{_label(name, observer)}: e' = {closed_form}{varying}", derived, claimed, inputs, where,
                           expected)
+
+
+def any_plant_error_dynamics_claim(name: str, kind: str, form: str, n: int, expected: str = "proved") -> Certificate:
+    """``e' = L M^-1 G e`` for every plant of n degrees of freedom: M^-1 (and the momentum form's M)
+    and the forces h as free symbols (:func:`uvsym.observers.actuator.any_plant_error_dynamics`), tau_d
+    constant. Proved in exact arithmetic, it covers what a vehicle's own graph cannot show where CasADi
+    folds products of M^-1's double constants into rounded doubles."""
+    d = any_plant_error_dynamics(kind, form, n)
+    derived = ca.substitute(d["e_dot"], d["tau_d_dot"], ca.DM.zeros(n))
+    claimed = ca.mtimes(d["A"], d["e"])
+    inputs = [d[v] for v in ("e", "f", "eta", "nu", "tau_d", "K", "h")] + [ca.vec(d["M_inv"]), ca.vec(d["M"])]
+    closed_form = "L M^-1 T_d e" if kind == "proportional" else "L M^-1 e"
+    return prove_identity(f"{name} ({form} form, any plant of {n} DOF): e' = {closed_form}", derived, claimed,
+                          [ca.vertcat(*inputs)], f"all e, f, eta, nu, K, every M^-1 and h(eta, nu) "
+                          f"({n} x {n} and {n} free symbols), tau_d constant", expected)
 
 
 def convergence_claim(name: str, observer: ActuatorObserver, K, tau_min: float, tau_max: float, gamma: float,
