@@ -7,12 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from derivations.uio_zonotope.claims import HEALTHY_RUNS, HEALTHY_SEED
 from derivations.uio_zonotope.design import SAMPLES, design
 from derivations.uio_zonotope.enclosure import check_enclosure
 from derivations.uio_zonotope.experiment import ABRUPT_SIZE, DRIFT_RATE, Fault, detection, simulate_runs
 
-__all__ = ["DRIFT_RATES", "FAULT_RUNS", "FAULT_SEED", "run_study"]
+__all__ = ["DRIFT_RATES", "FAULT_RUNS", "FAULT_SEED", "HEALTHY_RUNS", "HEALTHY_SEED", "run_study"]
+
+HEALTHY_RUNS = 100
+HEALTHY_SEED = 0
 
 FAULT_RUNS = 20  # seeded runs per fault case
 FAULT_SEED = 1  # other draws than the healthy runs

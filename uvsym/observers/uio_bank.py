@@ -27,7 +27,8 @@ from uvsym.sets import Propagation, Zonotope, propagate
 from uvsym.sets.zonotope import finite_matrix
 from uvsym.systems.signals import Signals
 
-__all__ = ["UIOBank", "isolate", "outside_band", "residual_bands", "uio_bank"]
+__all__ = ["UIOBank", "decision_limits", "isolate", "outside_band", "residual_bands", "residual_recursion",
+           "uio_bank"]
 
 
 @dataclass(frozen=True)
@@ -63,14 +64,12 @@ def uio_bank(A, B, C, D, poles, *, states: Signals, outputs: Signals, inputs: Si
     return UIOBank(tuple(designs), tuple(observers), tuple(inputs.names))
 
 
-def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, generators: int,
-                   method: str = "girard", growth_limit: float = 10.0, track: bool = True) -> Propagation:
-    """Zonotopes of the healthy residual ``r_k``, k = 0 .. steps - 1 (module docstring).
+def residual_recursion(design: UIOMatrices, noise_bound, error_bound) -> tuple:
+    """``(A, C, initial, noise)`` of the healthy residual's recursion (module docstring): A (n + p, n + p),
+    C (p, n + p) and the initial and noise zonotopes of ``xi = [e; v]``.
 
-    noise_bound: (p,) vbar (in the outputs' units); error_bound: (n,) ebar of the initial error;
-    track: keep the reductions' coefficient maps (see :func:`uvsym.sets.carry_coefficients`).
-    Raises SetError for a bound that is not finite and non-negative or of the wrong size,
-    SetDivergenceError when the enclosure grows (an unstable F, or reduction wrapping)."""
+    noise_bound: (p,) vbar (in the outputs' units); error_bound: (n,) ebar of the initial error.
+    Raises SetError for a bound that is not finite and non-negative or of the wrong size."""
     n, p = design.F.shape[0], design.C.shape[0]
     vbar = finite_matrix(noise_bound, "noise bound", (p,))
     ebar = finite_matrix(error_bound, "initial error bound", (n,))
@@ -81,7 +80,17 @@ def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, ge
     A = np.block([[design.F, -design.K1], [np.zeros((p, n + p))]])
     noise = Zonotope(np.zeros(n + p), np.vstack([-design.Q @ V, V]))
     initial = Zonotope(np.zeros(n + p), np.block([[np.diag(ebar), np.zeros((n, p))], [np.zeros((p, n)), V]]))
-    return propagate(A, np.hstack([design.C, np.eye(p)]), initial, noise, steps, generators, method, growth_limit,
+    return A, np.hstack([design.C, np.eye(p)]), initial, noise
+
+
+def residual_bands(design: UIOMatrices, noise_bound, error_bound, steps: int, generators: int,
+                   method: str = "girard", growth_limit: float = 10.0, track: bool = True) -> Propagation:
+    """Zonotopes of the healthy residual ``r_k``, k = 0 .. steps - 1, of :func:`residual_recursion`.
+
+    track: keep the reductions' coefficient maps (see :func:`uvsym.sets.carry_coefficients`).
+    Raises SetError for a bad bound (:func:`residual_recursion`), SetDivergenceError when the
+    enclosure grows (an unstable F, or reduction wrapping)."""
+    return propagate(*residual_recursion(design, noise_bound, error_bound), steps, generators, method, growth_limit,
                      track)
 
 
@@ -97,11 +106,18 @@ def outside_band(residuals, bands: Propagation, tolerance: float = 1e-12) -> np.
     if r.ndim not in (2, 3) or r.shape[0] > len(bands.lower) or r.shape[1] != bands.lower.shape[1]:
         raise SetError(f"residuals must be (N, {bands.lower.shape[1]}[, runs]) with N <= {len(bands.lower)}, "
                        f"got {r.shape}")
-    lower, upper = bands.lower[:len(r)], bands.upper[:len(r)]
+    lower, upper = decision_limits(bands, tolerance)
+    lower, upper = lower[:len(r)], upper[:len(r)]
     if r.ndim == 3:
         lower, upper = lower[..., None], upper[..., None]
-    slack = tolerance * (1.0 + np.abs(upper - lower))
-    return np.any((r < lower - slack) | (r > upper + slack), axis=1)
+    return np.any((r < lower) | (r > upper), axis=1)
+
+
+def decision_limits(bands: Propagation, tolerance: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+    """(N, p) lowest and highest residual :func:`outside_band` lets pass: each hull bound moved out by
+    ``tolerance * (1 + width)`` (floats, as the decision compares them)."""
+    slack = tolerance * (1.0 + np.abs(bands.upper - bands.lower))
+    return bands.lower - slack, bands.upper + slack
 
 
 def isolate(outside: np.ndarray, names, start: int, window: int) -> list[str]:

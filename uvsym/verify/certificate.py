@@ -63,6 +63,9 @@ class Certificate:
         if "V_dot" in example:
             point = ", ".join(f"{name} = {value:.{digits}g}" for name, value in example["x"].items())
             return f"at {point}: V' = {example['V_dot']:.{digits}g} > {example['bound']:.{digits}g}"
+        if "reached" in example:
+            return (f"at step {example['step']}, output {example['output']}: a vertex reaches "
+                    f"{example['reached']:.{digits}g}, beyond the limit {example['limit']:.{digits}g}")
         if "relative_difference" in example:
             return (f"the two sides differ by {example['relative_difference']:.{digits}g} (relative to the size of "
                     f"their terms) at a sampled point")
