@@ -5,9 +5,11 @@ An executor's ``run(chunks, settings, on_chunk)`` executes every run of ``chunks
 each chunk completes (its rows in the chunk's order). ``start()`` connects, before any run, and
 ``close()`` releases the workers.
 
-:class:`LocalExecutor` hands one run at a time to each of its processes; a process that dies
-during a run is replaced, and the run tried again in a new one, ``RETRIES`` times; then it gets
-an error row (``WorkerDied``: a rerun of the campaign tries it again), and the other runs go on.
+:class:`LocalExecutor` hands one chunk at a time to each of its processes (run there by
+:func:`~uvsym.campaign.worker.execute_many`, in lanes where the runs share a loop); a process that
+dies during a chunk is replaced and the chunk's runs are tried again one by one; a process that dies
+during a run alone is replaced and the run tried again ``RETRIES`` times; then it gets an error row
+(``WorkerDied``: a rerun of the campaign tries it again), and the other runs go on.
 :class:`DaskExecutor` submits one task per chunk to the scheduler at ``scheduler`` (or to a
 ``LocalCluster`` it starts when none is given); a chunk whose task fails (a worker killed) is
 resubmitted run by run, one after the other, and a run that fails alone gets an error row.
@@ -86,20 +88,20 @@ class LocalExecutor:
 
     def run(self, chunks, settings, on_chunk) -> None:
         self._context = _context()
-        pending = deque((index, run) for index, chunk in enumerate(chunks) for run in chunk)
+        pending = deque((index, list(chunk)) for index, chunk in enumerate(chunks) if chunk)  # jobs: runs of a chunk
         left = {index: len(chunk) for index, chunk in enumerate(chunks)}
         rows: dict[int, dict] = {index: {} for index in left}
         idle = [self._spawn(settings) for _ in range(min(self.workers, len(pending)))]
-        busy: dict = {}  # (process, conn) -> (chunk index, run)
+        busy: dict = {}  # (process, conn) -> (chunk index, runs)
         lost = 0  # processes found dead while idle
-        deaths: dict[str, int] = {}  # run id -> worker processes that died under it
+        deaths: dict[str, int] = {}  # run id -> worker processes that died under it alone
         try:
             while pending or busy:
                 while idle and pending:
                     slot, job = idle.pop(), pending.popleft()
                     try:
                         slot[1].send(job[1])
-                    except OSError:  # the idle process has gone: replace it, the run waits for the next
+                    except OSError:  # the idle process has gone: replace it, the job waits for the next
                         lost += 1
                         if lost > 2 * self.workers:
                             raise ExecutorError(f"{lost} local worker processes ended before taking a run "
@@ -111,37 +113,47 @@ class LocalExecutor:
                     busy[slot] = job
                 ready = set(wait([s[1] for s in busy] + [s[0].sentinel for s in busy]))
                 for slot in [s for s in busy if s[1] in ready or s[0].sentinel in ready]:
-                    (process, conn), (index, run) = slot, busy.pop(slot)
-                    row = None
+                    (process, conn), (index, runs) = slot, busy.pop(slot)
+                    answer = None
                     try:
                         if conn.poll():
-                            row = conn.recv()
+                            answer = conn.recv()
                     except (EOFError, OSError):
                         pass
-                    if row is None:  # the process died during the run: replaced, the run tried again
+                    if answer is None:  # the process died during the job: replaced, its runs tried again
                         process.join(5.0)
                         conn.close()
                         self._processes.remove(slot)
-                        deaths[run.id] = deaths.get(run.id, 0) + 1
-                        if deaths[run.id] <= RETRIES:
-                            pending.appendleft((index, run))
-                        else:
-                            row = worker.failure_row(run, f"WorkerDied: the worker process ended (exit code "
-                                                          f"{process.exitcode}) during this run, "
-                                                          f"{deaths[run.id]} times")
+                        answer = self._after_death(index, runs, deaths, pending, process.exitcode)
                         if pending:
                             idle.append(self._spawn(settings))
-                        if row is None:
+                        if answer is None:
                             continue
                     else:
                         idle.append(slot)
-                    rows[index][run.id] = row
-                    left[index] -= 1
+                    for run, row in zip(runs, answer):
+                        rows[index][run.id] = row
+                    left[index] -= len(runs)
                     if not left[index]:
                         on_chunk(index, [rows[index][r.id] for r in chunks[index]])
                         del rows[index]
         finally:
             self.close()
+
+    @staticmethod
+    def _after_death(index: int, runs: list, deaths: dict, pending: deque, exitcode) -> list[dict] | None:
+        """A job whose process died: several runs go back one by one (to find the one at fault); a run
+        alone is tried again up to RETRIES times, then answered with its error row (returned)."""
+        if len(runs) > 1:
+            pending.extendleft((index, [run]) for run in reversed(runs))
+            return None
+        run = runs[0]
+        deaths[run.id] = deaths.get(run.id, 0) + 1
+        if deaths[run.id] <= RETRIES:
+            pending.appendleft((index, [run]))
+            return None
+        return [worker.failure_row(run, f"WorkerDied: the worker process ended (exit code {exitcode}) during "
+                                        f"this run, {deaths[run.id]} times")]
 
     def close(self) -> None:
         for _, conn in self._processes:

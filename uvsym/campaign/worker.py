@@ -2,7 +2,11 @@
 
 A run that raises gives a row with ``status = "error"`` and ``error = "Type: message"``; it never
 ends the campaign. The functions here run in worker processes (local or Dask), so they take
-only picklable arguments.
+only picklable arguments. :func:`execute_many` runs a batch: the runs that can share a compiled
+step (method ``fast``, no supervisor or correcting diagnosis) go through
+:func:`uvsym.sim.batch.simulate_batch`, in lanes of one loop built and compiled once per worker
+for every fault size, current, initial state and seed; a batch in which a run fails is run again
+one run at a time, so that each failure is its own row.
 """
 
 from __future__ import annotations
@@ -16,7 +20,8 @@ from uvsym.campaign.metrics import METRIC_COLUMNS, run_metrics, truth
 from uvsym.campaign.spec import Run, Settings, storable
 from uvsym.errors import CampaignError
 
-__all__ = ["LOST_WORKER", "load_hook", "execute", "failure_row", "lost_worker", "run_chunk", "serve"]
+__all__ = ["LOST_WORKER", "load_hook", "execute", "execute_many", "failure_row", "lost_worker", "run_chunk",
+           "serve"]
 
 _SCALARS = (bool, int, float, str, type(None))
 
@@ -79,6 +84,59 @@ def execute(run: Run, settings: Settings, hook=None) -> dict:
     return row
 
 
+def _lane_ready(scenario, options: dict) -> bool:
+    """Whether simulate_batch runs ``scenario`` as simulate_any_scenario would with ``options``."""
+    from uvsym.sim.system_scenario import SystemScenario
+
+    if options.get("method", "fast") != "fast" or set(options) - {"method", "compiled", "substeps"}:
+        return False
+    if isinstance(scenario, SystemScenario):
+        return scenario.supervisor is None
+    return scenario.diagnosis is None or not scenario.diagnosis.correct
+
+
+def execute_many(runs: list[Run], settings: Settings, hook=None) -> list[dict]:
+    """The rows of ``runs`` (in order), as :func:`execute` gives them; those that share a loop and its
+    options run in lanes (module docstring). Each lane row's ``wall_s`` is its share of its batch's time."""
+    from uvsym.sim.batch import simulate_batch
+    from uvsym.sim.system_scenario import parse_any_scenario
+
+    rows: dict[int, dict] = {}
+    batches: dict[tuple, list[tuple[int, object]]] = {}
+    for i, run in enumerate(runs):
+        options = dict(settings.simulation) | dict(run.simulation)
+        try:
+            scenario = parse_any_scenario(run.scenario)
+        except Exception:  # its error row comes from execute, which parses it again
+            rows[i] = execute(run, settings, hook)
+            continue
+        if _lane_ready(scenario, options):
+            batches.setdefault(tuple(sorted(options.items())), []).append((i, scenario))
+        else:
+            rows[i] = execute(run, settings, hook)
+    for key, members in batches.items():
+        options = dict(key)
+        started = time.perf_counter()
+        try:
+            results = simulate_batch([scenario for _, scenario in members], compiled=options.get("compiled", True),
+                                     substeps=options.get("substeps", 1))
+            batch = []
+            for (i, scenario), result in zip(members, results):
+                row = _base(runs[i]) | truth(scenario)
+                events = list(getattr(result, "events", None) or [])
+                row |= run_metrics(scenario, result, events)
+                if hook is not None:
+                    row |= _hook_columns(hook(scenario, result, events), settings.metrics, row)
+                batch.append((i, row | {"status": "ok", "error": None}))
+        except Exception:  # one run's failure: each run alone, for its own row
+            for i, _ in members:
+                rows[i] = execute(runs[i], settings, hook)
+            continue
+        share = (time.perf_counter() - started) / len(members)
+        rows.update((i, row | {"wall_s": share}) for i, row in batch)
+    return [rows[i] for i in range(len(runs))]
+
+
 def _hook_columns(columns, name: str, row: dict) -> dict:
     """The hook's columns, checked: new names (not a metric, a field or another column of ``row``),
     scalar values a results table can hold."""
@@ -95,21 +153,21 @@ def _hook_columns(columns, name: str, row: dict) -> dict:
 
 
 def run_chunk(runs: list[Run], settings: Settings) -> list[dict]:
-    """The rows of ``runs``, in order (a Dask task)."""
-    hook = load_hook(settings)
-    return [execute(run, settings, hook) for run in runs]
+    """The rows of ``runs``, in order (a Dask task), by :func:`execute_many`."""
+    return execute_many(runs, settings, load_hook(settings))
 
 
 def serve(conn, settings: Settings) -> None:
-    """A local worker process: receive runs on ``conn``, send back their rows, until None or the driver
-    goes. Ctrl-C is the driver's to handle (it stops the workers)."""
+    """A local worker process: receive batches of runs (lists) on ``conn``, send back their rows (a list,
+    by :func:`execute_many`), until None or the driver goes. Ctrl-C is the driver's to handle (it stops
+    the workers)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     hook = load_hook(settings)
     while True:
         try:
-            run = conn.recv()
-            if run is None:
+            runs = conn.recv()
+            if runs is None:
                 return
-            conn.send(execute(run, settings, hook))
+            conn.send(execute_many(runs, settings, hook))
         except (EOFError, OSError):  # the driver has gone: nothing to report to
             return

@@ -32,6 +32,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.checked import checked
+from uvsym.codegen.cache import memoized
 from uvsym.conventions import FORCE_LABELS, POSITION_LABELS, VELOCITY_LABELS
 from uvsym.errors import ObserverError
 from uvsym.faults import ActuatorKind, actuator_kind
@@ -65,9 +66,11 @@ class ActuatorObserver:
     error_dynamics: ca.Function
 
 
+@memoized(32)
 def actuator_observer(model: Model, kind: str, form: str = "paper",
                       require_assumption_1: bool = True) -> ActuatorObserver:
-    """Build the observer of ``kind`` (proportional, bias, constant) for ``model``.
+    """Build the observer of ``kind`` (proportional, bias, constant) for ``model`` (memoized in-process:
+    every scenario of a campaign over one vehicle shares its observers).
 
     ``require_assumption_1=False`` builds the paper's proportional observer on a coupled M anyway
     (to show by machine that it can diverge there; never for use).
