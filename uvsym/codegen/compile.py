@@ -165,6 +165,36 @@ def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...
     return roll
 
 
+def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
+    """runs(z0, Ws, outs) -> z_end calling ``symbol`` of ``library``: the lanes over each run's own arrays."""
+    n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
+    pointers = ctypes.c_void_p * lanes
+    function = getattr(ctypes.CDLL(str(library)), symbol)
+    function.argtypes = [_POINTER, pointers, _POINTER, pointers, ctypes.c_long]
+
+    def runs(z0: np.ndarray, Ws: list[np.ndarray], outs: list[np.ndarray]) -> np.ndarray:
+        """k steps of every lane: lane l reads the rows of Ws[l] (k, n_w) and writes outs[l] (k, n_out)
+        (C-contiguous float64 arrays; lanes may share an array, a padding lane its run's); z0, z_end (n_z, L)."""
+        z0 = np.ascontiguousarray(z0, dtype=float)
+        k = Ws[0].shape[0] if len(Ws) else 0
+
+        def fit(arrays, width: int, writes: bool) -> bool:
+            return len(arrays) == lanes and all(
+                a.shape == (k, width) and a.dtype == np.float64 and a.flags.c_contiguous
+                and (a.flags.writeable or not writes) for a in arrays)
+
+        if z0.shape != (n_z, lanes) or not (fit(Ws, n_w, False) and fit(outs, n_out, True)):
+            raise CodegenError(f"the lanes' runs need z0 ({n_z}, {lanes}) and {lanes} C-contiguous float64 W (k, "
+                               f"{n_w}) and out (k, {n_out}) of one k")
+        z_end = np.empty_like(z0)
+        if function(z0.ctypes.data_as(_POINTER), pointers(*(W.ctypes.data for W in Ws)),
+                    z_end.ctypes.data_as(_POINTER), pointers(*(out.ctypes.data for out in outs)), k):
+            raise CodegenError(f"{step.name()} failed inside the compiled loop")
+        return z_end
+
+    return runs
+
+
 _STRAIGHT = """
 __attribute__((noinline)) static void {name}_body(const double* restrict in0, const double* restrict in1,
                                                   double* restrict out0, double* restrict out1) {{
@@ -227,8 +257,8 @@ static inline double casadi_sign(double x) { return x < 0 ? -1. : x > 0 ? 1. : x
 static inline double casadi_fabs(double x) { return fabs(x); }
 """
 _LANES = """
-static void {name}_lanes_step(const double* restrict in0, const double* restrict in1, double* restrict out0,
-                              double* restrict out1) {{
+__attribute__((noinline)) static void {name}_lanes_step(const double* restrict in0, const double* restrict in1,
+                                                        double* restrict out0, double* restrict out1) {{
   #pragma omp simd
   for (long l = 0; l < {L}; ++l) {{
 {body}
@@ -241,6 +271,27 @@ int {name}_lanes_roll(const double* z0, const double* W, double* z_end, double* 
   for (long k = 0; k < N; ++k) {{
     {name}_lanes_step(z, W + k * {n_w} * {L}, zn, O + k * {n_out} * {L});
     swap = z; z = zn; zn = swap;  /* the next state becomes the state: no copy */
+  }}
+  memcpy(z_end, z, sizeof a);
+  return 0;
+}}
+/* the same roll over each lane's own row-major arrays W_l (N, n_w) and O_l (N, n_out), gathered into and
+   scattered from the structure of arrays one step at a time (in the cache: no pass over the runs' memory) */
+int {name}_lanes_runs(const double* z0, const double* const* W, double* z_end, double* const* O, long N) {{
+  double a[{n_z} * {L}], b[{n_z} * {L}], w[{n_w} * {L}], o[{n_out} * {L}];
+  double *z = a, *zn = b, *swap;
+  const double* Wl[{L}];
+  double* Ol[{L}];
+  memcpy(Wl, W, sizeof Wl);
+  memcpy(Ol, O, sizeof Ol);
+  memcpy(z, z0, sizeof a);
+  for (long k = 0; k < N; ++k) {{
+    for (long l = 0; l < {L}; ++l)
+      for (long j = 0; j < {n_w}; ++j) w[j * {L} + l] = Wl[l][k * {n_w} + j];
+    {name}_lanes_step(z, w, zn, o);
+    for (long l = 0; l < {L}; ++l)
+      for (long j = 0; j < {n_out}; ++j) Ol[l][k * {n_out} + j] = o[j * {L} + l];
+    swap = z; z = zn; zn = swap;
   }}
   memcpy(z_end, z, sizeof a);
   return 0;
@@ -277,8 +328,10 @@ def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_F
     gcc vectorises (through glibc's vector math library, libmvec, for sin, cos, atan2, exp, ...).
 
     Returns ``roll(z0 (n_z, L), W (k, n_w, L), out (k, n_out, L)) -> z_end (n_z, L)``: k steps of every
-    lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays). Memoized
-    in-process as :func:`compile_roll` is.
+    lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays); and
+    ``roll.runs(z0, Ws, outs) -> z_end``, the same over L runs' own arrays ``Ws[l]`` (k, n_w) and
+    ``outs[l]`` (k, n_out), as the scalar roll takes them (no stacking or transposing of whole runs).
+    Memoized in-process as :func:`compile_roll` is.
 
     Raises CodegenError when there is no compiler, the step is not straight-line scalar code, or
     compilation (or linking with libmvec) fails.
@@ -301,6 +354,10 @@ def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_F
     not_builtin = tuple(f"-fno-builtin-{name}" for name in _VECTOR_MATH)
     # gcc prefers 256-bit vectors on AVX-512 processors: lanes that fill a 512-bit register ask for it
     wide = ("-mprefer-vector-width=512",) if vector_doubles() == 8 and lanes % 8 == 0 else ()
-    library = _build(step, recipe, (*flags, *not_builtin, *wide, "-fopenmp-simd", "-Wl,-z,defs"),
+    # gcc 12's partial redundancy elimination folds CasADi's ``c ? b : 0`` of comparisons into selects of
+    # boolean masks of two widths its vectoriser cannot take: the lane loop then runs one lane at a time
+    library = _build(step, recipe, (*flags, *not_builtin, *wide, "-fno-tree-pre", "-fopenmp-simd", "-Wl,-z,defs"),
                      ("-lmvec", "-lm"), generated=source)
-    return _roller(step, library, f"{step.name()}_lanes_roll", (lanes,))
+    roll = _roller(step, library, f"{step.name()}_lanes_roll", (lanes,))
+    roll.runs = _runs_roller(step, library, f"{step.name()}_lanes_runs", lanes)
+    return roll

@@ -28,7 +28,7 @@ from typing import Sequence
 
 import numpy as np
 
-from uvsym.codegen.cache import frozen
+from uvsym.codegen.cache import frozen, memoized
 from uvsym.codegen.compile import compile_lanes, vector_doubles
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
@@ -36,7 +36,7 @@ from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.run import CHUNK, check_chunk, run_closed_loop
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import PreparedRun, observer_blocks, prepare_run, scenario_arguments
-from uvsym.sim.step_error import checked_steps
+from uvsym.sim.step_error import checked_runs
 
 __all__ = ["LANES", "default_lanes", "simulate_batch", "run_lanes"]
 
@@ -164,42 +164,49 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
             warnings.warn(f"running the batch one run after another: {exc}", stacklevel=2)
         return [_scalar(run, compiled) for run in runs]
     build_s = time.perf_counter() - started
+    n_out = loop.discrete.size1_out("out")
     results = []
     for first in range(0, len(runs), lanes):
         group = list(runs[first:first + lanes])
-        group += group[-1:] * (lanes - len(group))  # padding lanes repeat the last run
         started = time.perf_counter()
-        W = np.ascontiguousarray(np.stack([run.W for run in group], axis=-1))
-        z = np.ascontiguousarray(np.stack([run.z0 for run in group], axis=-1))
-        outputs = np.empty((N + 1, loop.discrete.size1_out("out"), lanes))
-        real = min(lanes, len(runs) - first)
+        # each run's own W and logged rows, as the scalar path has them: the roll gathers and scatters the lanes
+        Ws = [np.ascontiguousarray(run.W, dtype=float) for run in group]
+        outputs = [np.empty((N + 1, n_out)) for _ in group]
+        padding = lanes - len(group)  # padding lanes repeat the last run, into its own rows (the same values)
+        lane_W, lane_out = Ws + Ws[-1:] * padding, outputs + outputs[-1:] * padding
+        z = np.stack([run.z0 for run in group] + [group[-1].z0] * padding, axis=-1)
         for start in range(0, N, CHUNK["fast"]):
             k = min(CHUNK["fast"], N - start)
-            z = roll(z, W[start:start + k], outputs[start:start + k])
-            clean = bool(np.isfinite(outputs[start:start + k]).all() and np.isfinite(z).all())
-            for lane in range(real):
-                W_rows, rows, guard = W[start:start + k, :, lane], outputs[start:start + k, :, lane], group[lane].guard
+            z = roll.runs(z, [W[start:start + k] for W in lane_W], [out[start:start + k] for out in lane_out])
+            for lane, (W, out, run) in enumerate(zip(Ws, outputs, group)):
+                W_rows, rows = W[start:start + k], out[start:start + k]
                 try:
-                    if not clean:
-                        check_chunk(loop, "fast", start, W_rows, rows, z[:, lane], guard)
-                    elif guard is not None:
-                        guard(W_rows[:, 0], rows)
+                    if not (np.isfinite(rows).all() and np.isfinite(z[:, lane]).all()):
+                        check_chunk(loop, "fast", start, W_rows, rows, z[:, lane], run.guard)
+                    elif run.guard is not None:
+                        run.guard(W_rows[:, 0], rows)
                 except SimulationError as exc:
                     raise SimulationError(f"run {names[first + lane]}: {exc}") from None
-        for lane in range(real):
-            outputs[N, :, lane] = np.asarray(loop.discrete(z[:, lane], W[N, :, lane])[2]).ravel()
-        by_lane = np.ascontiguousarray(outputs.transpose(2, 0, 1)[:real])  # (lane, sample, out): one pass
+        last = np.asarray(_final(loop.discrete, lanes)(z, np.stack([W[N] for W in lane_W], axis=-1))[2])
+        for lane, out in enumerate(outputs):
+            out[N] = last[:, lane]
         wall = time.perf_counter() - started
-        for lane, run in enumerate(group[:real]):  # views of the lane's own block: no copy per signal
-            signals = {name: Signal(by_lane[lane, :, sl], labels, units)
-                       for name, (sl, labels, units) in loop.signals.items()}
+        checked = [(lane, (out, W, run.rk4_tolerance)) for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))
+                   if run.rk4_tolerance is not None]  # as the scalar path checks them, all in one call
+        errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked])))
+        for lane, (run, W, out) in enumerate(zip(group, Ws, outputs)):  # views of the run's rows: no copy
+            signals = {name: Signal(out[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
             meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}
-            checked = None if run.rk4_tolerance is None else checked_steps(loop, by_lane[lane], run.W,
-                                                                             run.rk4_tolerance)
-            if checked is not None:  # as the scalar path checks it
-                meta["rk4_error"] = checked
-            results.append(SimResult(run.W[:, 0].copy(), signals, meta))
+            if errors.get(lane) is not None:
+                meta["rk4_error"] = errors[lane]
+            results.append(SimResult(W[:, 0].copy(), signals, meta))
     return results
+
+
+@memoized(16)
+def _final(discrete, lanes: int):
+    """The loop's discrete part over ``lanes`` columns (the logged row after the last step of each lane)."""
+    return discrete.map(lanes)
 
 
 def _scalar(run: PreparedRun, compiled: bool) -> SimResult:

@@ -27,8 +27,8 @@ from uvsym.codegen.cache import memoized
 from uvsym.errors import IntegrationAccuracyWarning, SimulationError
 from uvsym.symbolic import rk4
 
-__all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance", "checked_steps", "state_name",
-           "step_error"]
+__all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance", "checked_runs", "checked_steps",
+           "state_name", "step_error", "step_errors"]
 
 CHECKS, EARLY, JUMPS = 32, 4, 12
 TOLERANCE = 1e-4  # default: local error per sample, relative to each state entry's scale over the run
@@ -69,12 +69,30 @@ def check_indices(U: np.ndarray, switching: np.ndarray | None = None) -> list[in
     N = len(U) - 1
     if N < 1:
         return []
-    scale = np.max(np.abs(U), axis=0) + 1e-300
+    scale = _column_max(U) + 1e-300
     change = np.max(np.abs(np.diff(U[:N], axis=0, prepend=U[:1])) / scale, axis=1) if U.shape[1] else np.zeros(N)
-    jumps = np.argsort(-change, kind="stable")[:JUMPS]
     spread = np.linspace(0, N - 1, max(1, CHECKS - EARLY - JUMPS)).round().astype(int)
-    chosen = {*range(min(EARLY, N)), *(int(k) for k in jumps if change[k] > 0), *(int(k) for k in spread)}
+    chosen = {*range(min(EARLY, N)), *(int(k) for k in _largest(change, JUMPS)), *(int(k) for k in spread)}
     return sorted(k for k in chosen if switching is None or not switching[k])
+
+
+def _column_max(A: np.ndarray) -> np.ndarray:
+    """(n,) the largest |entry| of each column of A (k, n), one contiguous pass per column (numpy's reduction
+    over the rows of a narrow table steps row by row)."""
+    return np.abs(np.ascontiguousarray(A.T)).max(axis=1)
+
+
+def _largest(change: np.ndarray, count: int) -> np.ndarray:
+    """The samples of the ``count`` largest positive changes, ties to the earlier sample (those a stable sort
+    of -change puts first), in O(N): a partition, not a sort."""
+    positive = np.where(change > 0, change, 0.0)  # NaN and no change are never chosen
+    if positive.size > count:
+        kth = np.partition(positive, positive.size - count)[positive.size - count]  # the count-th largest
+        above = np.flatnonzero(positive > kth)
+        chosen = np.concatenate([above, np.flatnonzero(positive == kth)[:count - above.size]])
+    else:
+        chosen = np.arange(positive.size)
+    return chosen[positive[chosen] > 0]
 
 
 @memoized(16)
@@ -87,40 +105,66 @@ def _doubled(plant_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
 
 
 @memoized(16)
-def _mapped(doubled: ca.Function) -> ca.Function:
-    """``doubled`` over ``CHECKS`` steps at once, one per column."""
-    return doubled.map(CHECKS)
+def _mapped(doubled: ca.Function, runs: int) -> ca.Function:
+    """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column."""
+    return doubled.map(CHECKS * runs)
 
 
 def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> StepError | None:
     """The largest error of the checked steps of a finished run (module docstring): outputs (N + 1, n_out)
     its logged rows, W (N + 1, n_w) its inputs. None for a discrete-time plant, a loop that cannot read its
     integrated state back, or a run of no step."""
-    if loop.plant_ode is None or len(W) < 2:
+    return step_errors(loop, [(outputs, W, tolerance)])[0]
+
+
+def step_errors(loop, runs) -> list[StepError | None]:
+    """:func:`step_error` of each run ``(outputs, W, tolerance)`` of one loop, every checked step of every run
+    in one call of the doubled step mapped over them all."""
+    if loop.plant_ode is None:
+        return [None] * len(runs)
+    plans = [_plan(loop, outputs, W, tolerance) for outputs, W, tolerance in runs]
+    checked = [plan for plan in plans if plan is not None and plan[-1]]
+    if checked:  # the rows of each run's checked steps (its last one repeated to fill CHECKS columns)
+        rows = [ks + ks[-1:] * (CHECKS - len(ks)) for *_, ks in checked]
+        arguments = [np.concatenate(parts, axis=1) for parts in zip(*(
+            (S[r].T, U[r].T, W[r][:, loop.env_columns].T, W[r, 0][None, :])
+            for (_, S, U, W, _), r in zip(checked, rows)))]
+        doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
+        coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(checked))(*arguments))
+    errors, i = [], 0
+    for plan in plans:
+        if plan is None:
+            errors.append(None)
+            continue
+        scale, _, _, W, ks = plan
+        worst = (0.0, 0.0, 0)
+        if ks:
+            block = slice(i * CHECKS, i * CHECKS + len(ks))
+            i += 1
+            ratio = np.abs(coarse[block] - fine[block]) * (16.0 / 15.0) / scale  # (checked, entries)
+            entries = np.argmax(ratio, axis=1)
+            largest = ratio[np.arange(len(ks)), entries]
+            valid = np.flatnonzero(np.isfinite(largest) & (largest > 0))  # a step with a non-finite entry says nothing
+            if valid.size:
+                j = int(valid[np.argmax(largest[valid])])
+                worst = (float(largest[j]), float(W[ks[j], 0]), int(entries[j]))
+        ratio, t_s, entry = worst
+        needed = loop.substeps if ratio <= 1.0 else math.ceil(loop.substeps * ratio ** 0.25)
+        errors.append(StepError(ratio, t_s, entry, needed, len(ks)))
+    return errors
+
+
+def _plan(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float):
+    """(scale, S, U, W, checked samples) of a run's step check, or None where nothing can be checked."""
+    if len(W) < 2:
         return None
     read = loop.integrated(outputs)
     if read is None:
         return None
     S, U = read
-    scale = tolerance * np.max(np.abs(S), axis=0) + ATOL
-    doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
     faulty = loop.logged(outputs, "fault_actuator") != 0
     ks = check_indices(U, np.any(faulty[1:] != faulty[:-1], axis=1) if faulty.shape[1] else None)
-    worst = (0.0, 0.0, 0)
-    if ks:  # every checked step in one call of the map over CHECKS steps (the last one repeated to fill it)
-        rows = ks + ks[-1:] * (CHECKS - len(ks))
-        steps = _mapped(doubled)(S[rows].T, U[rows].T, W[rows][:, loop.env_columns].T, W[rows, 0][None, :])
-        coarse, fine = (np.asarray(v).T[:len(ks)] for v in steps)
-        ratio = np.abs(coarse - fine) * (16.0 / 15.0) / scale  # (checked, entries)
-        entries = np.argmax(ratio, axis=1)
-        largest = ratio[np.arange(len(ks)), entries]
-        valid = np.flatnonzero(np.isfinite(largest) & (largest > 0))  # a step with a non-finite entry says nothing
-        if valid.size:
-            j = int(valid[np.argmax(largest[valid])])
-            worst = (float(largest[j]), float(W[ks[j], 0]), int(entries[j]))
-    ratio, t_s, entry = worst
-    needed = loop.substeps if ratio <= 1.0 else math.ceil(loop.substeps * ratio ** 0.25)
-    return StepError(ratio, t_s, entry, needed, len(ks))
+    return tolerance * _column_max(S) + ATOL, S, U, W, ks
 
 
 def state_name(loop, entry: int) -> str:
@@ -134,13 +178,23 @@ def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) ->
     """The step error of a finished run (:func:`step_error`) as the result's ``rk4_error`` meta, with an
     IntegrationAccuracyWarning (naming the state, the time and the substeps that would do) when it
     misses the tolerance; None where nothing was checked."""
-    error = step_error(loop, outputs, W, tolerance)
-    if error is None:
-        return None
-    if error.ratio > 1.0:
-        warnings.warn(f"fast method: RK4 with {loop.substeps} substep(s) per {loop.dt:g} s sample misses the "
-                      f"tolerance {tolerance:g} by a factor {error.ratio:.3g} at t = {error.t_s:g} s in "
-                      f"{state_name(loop, error.entry)} (step doubling on {error.checked} sampled steps, the error "
-                      f"against the entry's largest value in the run); substeps = {error.substeps_needed} would "
-                      "meet it (or a CasADi integrator method)", IntegrationAccuracyWarning, stacklevel=4)
-    return error.as_dict() | {"tolerance": tolerance, "state": state_name(loop, error.entry)}
+    return checked_runs(loop, [(outputs, W, tolerance)], stacklevel=5)[0]
+
+
+def checked_runs(loop, runs, stacklevel: int = 4) -> list[dict | None]:
+    """:func:`checked_steps` of each run ``(outputs, W, tolerance)`` of one loop (:func:`step_errors`);
+    stacklevel: the warnings', counted from this function."""
+    metas = []
+    for (_, _, tolerance), error in zip(runs, step_errors(loop, runs)):
+        if error is None:
+            metas.append(None)
+            continue
+        if error.ratio > 1.0:
+            warnings.warn(f"fast method: RK4 with {loop.substeps} substep(s) per {loop.dt:g} s sample misses the "
+                          f"tolerance {tolerance:g} by a factor {error.ratio:.3g} at t = {error.t_s:g} s in "
+                          f"{state_name(loop, error.entry)} (step doubling on {error.checked} sampled steps, the "
+                          "error against the entry's largest value in the run); substeps = "
+                          f"{error.substeps_needed} would meet it (or a CasADi integrator method)",
+                          IntegrationAccuracyWarning, stacklevel=stacklevel)
+        metas.append(error.as_dict() | {"tolerance": tolerance, "state": state_name(loop, error.entry)})
+    return metas
