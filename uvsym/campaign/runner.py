@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib
+import threading
 from pathlib import Path
 
 import pyarrow as pa
@@ -66,6 +68,8 @@ def run_campaign(campaign: Campaign, out_dir=None, *, executor=None, workers: in
     say(f"{campaign.name}: {len(campaign.runs)} runs, {len(campaign.runs) - len(todo)} finished before, "
         f"{len(todo)} to run in {len(chunks)} chunks on {type(executor).__name__}; writing {store.folder}")
     if chunks:
+        # the report's plotting library loads while the workers run (the driver waits on them meanwhile)
+        threading.Thread(target=importlib.import_module, args=("uvsym.report.figures",), daemon=True).start()
         executor.start()
         store.create()
         kinds = {c: column_kind([run.fields.get(c) for run in campaign.runs]) for c in campaign.columns}

@@ -25,6 +25,7 @@ def save_svg(fig, path: Path, png: bool = False) -> None:
     clipped = text_outside_figure(fig)
     if clipped:
         warnings.warn(f"{path.name}: text outside the figure: {'; '.join(clipped)}", RuntimeWarning, stacklevel=2)
+    fig.set_layout_engine("none")  # keep the layout the check drew: the saves below do not lay it out again
     with matplotlib.rc_context({"svg.hashsalt": RC["svg.hashsalt"], "svg.fonttype": RC["svg.fonttype"]}):
         fig.savefig(path, format="svg", metadata={"Date": None, "Creator": None})
     if png:
