@@ -3,7 +3,9 @@ columns deliver what the symbolic fault model delivers, and the batch refuses wh
 
 from __future__ import annotations
 
+import tomllib
 from dataclasses import replace
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -16,6 +18,7 @@ from uvsym.sim.batch import simulate_batch
 from uvsym.sim.closed_loop import actuator_fault_columns, build_closed_loop
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import observer_blocks, simulate_scenario
+from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
 
 
 @pytest.fixture(scope="module")
@@ -49,6 +52,34 @@ def test_each_lane_equals_the_scalar_run_of_its_scenario(scenarios):
         symbolic = np.column_stack([np.asarray(apply_actuator_faults(ca.DM(a), t, scenario.actuator_faults)).ravel()
                                     for a, t in zip(healthy[::25], lane.t[::25])]).T
         np.testing.assert_allclose(lane["u_actual"].values[::25], symbolic, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+def test_the_step_check_of_a_group_in_one_call_finds_what_each_runs_own_check_finds():
+    """Three DC motor runs (bias sizes, onsets, seeds apart): each lane's rk4_error as its scalar run's."""
+    root = Path(__file__).resolve().parents[1] / "examples" / "dc_motor"
+    table = tomllib.loads((root / "speed_sensor_bias.toml").read_text())
+    variants = [parse_system_scenario(dict(table, duration=2.0, seed=k, faults=[
+        dict(table["faults"][0], value=1.0 + k, onset=0.5 + 0.3 * k)]), root=root) for k in range(3)]
+    for scenario, lane in zip(variants, simulate_batch(variants, lanes=4)):
+        checked, alone = lane.meta["rk4_error"], simulate_system_scenario(scenario).meta["rk4_error"]
+        assert checked["steps_checked"] > 20 and checked["largest_error_ratio"] > 0
+        assert checked["largest_error_ratio"] == pytest.approx(alone["largest_error_ratio"], rel=1e-9)
+        assert {k: v for k, v in checked.items() if k != "largest_error_ratio"} == \
+            {k: v for k, v in alone.items() if k != "largest_error_ratio"}
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+@pytest.mark.filterwarnings("ignore::uvsym.errors.IntegrationAccuracyWarning")
+def test_runs_sharing_one_constant_current_run_it_built_into_the_lanes_step(scenarios):
+    """A current every run of a group holds (here 0.3 m/s from 0.8 rad) is built into the shared step, as
+    the scalar path builds each run's: each lane still equals its scalar run."""
+    currents = [replace(s, current=(0.3, 0.8)) for s in scenarios]
+    for scenario, lane in zip(currents, simulate_batch(currents, lanes=4)):
+        expected = simulate_scenario(scenario)["x"].values
+        np.testing.assert_allclose(lane["x"].values, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    still = simulate_scenario(scenarios[0])["x"].values
+    assert not np.allclose(simulate_batch(currents[:1])[0]["x"].values, still)  # the current did act
 
 
 def test_fault_columns_compose_faults_in_order_as_worked_by_hand(scenarios):

@@ -1,11 +1,13 @@
 """The lanes' compiled library: its width from the processor, its math through libmvec's vector
-functions, and lanes equal to the scalar roll of the same step (uvsym.codegen.compile)."""
+functions, its arithmetic in vector registers, and lanes equal to the scalar roll of the same step
+(uvsym.codegen.compile), also over each run's own arrays."""
 
 from __future__ import annotations
 
 import re
 import shutil
 import subprocess
+import tomllib
 from pathlib import Path
 
 import casadi as ca
@@ -13,6 +15,7 @@ import numpy as np
 import pytest
 
 from uvsym.codegen.compile import compile_lanes, compile_roll, find_compiler, vector_doubles
+from uvsym.errors import CodegenError
 from uvsym.sim.batch import LANES, default_lanes
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
@@ -76,3 +79,45 @@ def test_each_lane_equals_the_scalar_roll(lanes):
         np.testing.assert_allclose(out[:, :, lane], own, rtol=1e-12, atol=1e-14)
         np.testing.assert_allclose(z_end[:, lane], z_lane, rtol=1e-12, atol=1e-14)
     assert not np.allclose(out[:, :, 0], out[:, :, -1]) or lanes == 1  # the lanes ran apart
+
+
+def test_the_runs_roll_equals_the_lanes_roll_over_each_runs_own_arrays():
+    """roll.runs reads each run's own (k, n_w) rows and writes its own (k, n_out) rows: the same numbers as
+    the structure-of-arrays roll, a padding lane sharing its run's arrays; mismatched arrays are refused."""
+    step, N, lanes = _step(), 300, 4
+    rng = np.random.default_rng(7)
+    z0 = rng.uniform(-1.0, 1.0, (2, 3))
+    Ws = [np.ascontiguousarray(rng.uniform(-2.0, 2.0, (N, 2))) for _ in range(3)]
+    roll = compile_lanes(step, lanes)
+    outs = [np.empty((N, 2)) for _ in range(3)]
+    z_end = roll.runs(np.column_stack([z0, z0[:, -1]]), Ws + Ws[-1:], outs + outs[-1:])
+    soa = np.empty((N, 2, lanes))
+    soa_end = roll(np.column_stack([z0, z0[:, -1]]), np.ascontiguousarray(np.stack(Ws + Ws[-1:], axis=-1)), soa)
+    for lane in range(3):
+        np.testing.assert_array_equal(outs[lane], soa[:, :, lane])
+    np.testing.assert_array_equal(z_end, soa_end)
+    with pytest.raises(CodegenError, match="C-contiguous float64 W"):
+        roll.runs(z_end, Ws + [Ws[0][:, :1]], outs + outs[-1:])
+    with pytest.raises(CodegenError, match="of one k"):
+        roll.runs(z_end, Ws + Ws[-1:], outs[:2] + [outs[2][:-1], outs[2][:-1]])
+
+
+@pytest.mark.skipif(shutil.which("objdump") is None, reason="no objdump (binutils) to read the library's code")
+def test_the_dc_motor_step_runs_its_lanes_in_vector_registers():
+    """The DC motor loop (PI with saturation, Luenberger, UKF) holds CasADi's ``c ? b : 0`` of comparisons,
+    which gcc's partial redundancy elimination once turned into masks it could not vectorise: the lane
+    loop then ran one lane at a time (only scalar double arithmetic, ...sd). Its lanes step must compute
+    in packed doubles (...pd)."""
+    if vector_doubles() < 4:
+        pytest.skip("this processor has no 256-bit vectors")
+    from uvsym.sim.system_scenario import parse_system_scenario
+
+    root = Path(__file__).resolve().parents[1] / "examples" / "dc_motor"
+    table = tomllib.loads((root / "speed_sensor_bias.toml").read_text())
+    step = parse_system_scenario(table, root=root).loop.step
+    listing = subprocess.run(["objdump", "-d", str(compile_lanes(step, 4).library)], capture_output=True,
+                             text=True).stdout
+    body = re.search(rf"<{step.name()}_lanes_step>:\n(.*?)\n\n", listing, re.S).group(1)
+    arithmetic = r"v(add|sub|mul|div|fn?m(add|sub)\d*)"
+    packed, scalar = len(re.findall(arithmetic + "pd", body)), len(re.findall(arithmetic + "sd", body))
+    assert packed > 10 * max(scalar, 1), (packed, scalar)

@@ -15,6 +15,7 @@ from problems import first_order
 from uvsym.errors import IntegrationAccuracyWarning, ScenarioError, SimulationError
 from uvsym.faults import ActuatorFault, Profile
 from uvsym.sim import open_loop, simulate_system
+from uvsym.sim.step_error import CHECKS, EARLY, JUMPS, check_indices
 from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
 
 A, B, DT = 40.0, 2.0, 0.05  # v' = -a v + b F: a stiff step for RK4 at a dt of 0.05 s (a dt = 2)
@@ -96,3 +97,20 @@ def test_a_scenario_sets_its_tolerance_or_turns_the_check_off():
     table["rk4_tolerance"] = -1
     with pytest.raises(ScenarioError, match="rk4_tolerance: expected a positive number or false, got -1"):
         parse_system_scenario(table)
+
+
+def test_the_jumps_checked_are_the_largest_changes_ties_to_the_earlier_sample():
+    """Held inputs stepping by 3 at three samples and by 2 at twenty (integers: exact, equal changes), by 1
+    elsewhere: the JUMPS checked jumps are the three largest and the earliest nine of the tied twenty, beside
+    the first EARLY samples and the evenly spread ones."""
+    N = 400
+    steps = np.ones(N + 1)
+    big, tied = [350, 127, 390], list(range(30, 330, 15))
+    steps[big], steps[tied] = 3.0, 2.0
+    U = np.cumsum(steps)[:, None]  # U[k] - U[k - 1] = steps[k]
+    spread = {round(k) for k in np.linspace(0, N - 1, CHECKS - EARLY - JUMPS)}
+    expected = set(range(EARLY)) | set(big) | set(tied[:JUMPS - len(big)]) | spread
+    assert check_indices(U) == sorted(expected)
+    switching = np.zeros(N, bool)
+    switching[tied[0]] = True  # a step where a fault switches is left out, not replaced
+    assert check_indices(U, switching) == sorted(expected - {tied[0]})

@@ -2,7 +2,8 @@
 
 Runs that share the compiled step -- the same vehicle, controller, observers, sensor faults, step,
 duration and substeps -- differ freely in initial state, current, actuator faults (they are
-per-sample inputs of the step, :mod:`uvsym.sim.closed_loop`) and noise seed. They run ``lanes`` at
+per-sample inputs of the step, :mod:`uvsym.sim.closed_loop`; a constant current all of them share is
+built into the step instead, as the scalar path builds it) and noise seed. They run ``lanes`` at
 a time through :func:`uvsym.codegen.compile_lanes`: one C loop over the steps whose body runs every
 lane side by side, vectorised by the compiler. Each run's result equals :func:`simulate_scenario`'s
 for it up to rounding (the vector math library's sin, cos, ... differ from the scalar ones in the
@@ -100,7 +101,8 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
         first = scenarios[members[0]]
         observers = observer_blocks(first.model, first.observers, first.step)
         loop = build_closed_loop(first.model, first.controller, first.step, sensor_faults=first.sensor_faults,
-                                 observers=observers, substeps=substeps)
+                                 observers=observers, substeps=substeps,
+                                 current=_shared_current([scenarios[i] for i in members]))
         runs = [prepare_run(scenarios[i].model, scenarios[i].controller, **scenario_arguments(scenarios[i], observers),
                             substeps=substeps, loop=loop) for i in members]
         names = [scenarios[i].name for i in members]
@@ -113,6 +115,16 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
         for i, result in zip(members, _system_lanes([scenarios[i] for i in members], lanes, compiled)):
             results[i] = result
     return results
+
+
+def _shared_current(scenarios: list[Scenario]) -> tuple[float, float] | None:
+    """The constant current (V_c, beta_c) every scenario of a group holds, built into the lanes' step as the
+    scalar path builds it into its own (fewer operations: no current, no trigonometry of it); None when
+    they differ or vary in time (each run's current then read from its W)."""
+    currents = {tuple(float(c) for c in s.current) for s in scenarios}
+    if len(currents) == 1 and all(s.current_variation[0] == 0.0 for s in scenarios):
+        return currents.pop()
+    return None
 
 
 def _system_lanes(scenarios: list, lanes: int | None, compiled: bool) -> list[SimResult]:

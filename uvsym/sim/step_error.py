@@ -69,8 +69,10 @@ def check_indices(U: np.ndarray, switching: np.ndarray | None = None) -> list[in
     N = len(U) - 1
     if N < 1:
         return []
-    scale = _column_max(U) + 1e-300
-    change = np.max(np.abs(np.diff(U[:N], axis=0, prepend=U[:1])) / scale, axis=1) if U.shape[1] else np.zeros(N)
+    by_input = np.ascontiguousarray(U.T)  # (m, N + 1): the reductions below run along contiguous rows
+    scale = np.abs(by_input).max(axis=1) + 1e-300
+    change = (np.abs(np.diff(by_input[:, :N], axis=1, prepend=by_input[:, :1])) / scale[:, None]).max(axis=0) \
+        if len(by_input) else np.zeros(N)
     spread = np.linspace(0, N - 1, max(1, CHECKS - EARLY - JUMPS)).round().astype(int)
     chosen = {*range(min(EARLY, N)), *(int(k) for k in _largest(change, JUMPS)), *(int(k) for k in spread)}
     return sorted(k for k in chosen if switching is None or not switching[k])
@@ -162,8 +164,8 @@ def _plan(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float):
     if read is None:
         return None
     S, U = read
-    faulty = loop.logged(outputs, "fault_actuator") != 0
-    ks = check_indices(U, np.any(faulty[1:] != faulty[:-1], axis=1) if faulty.shape[1] else None)
+    faulty = np.ascontiguousarray(loop.logged(outputs, "fault_actuator").T) != 0  # (m, N + 1)
+    ks = check_indices(U, np.any(faulty[:, 1:] != faulty[:, :-1], axis=0) if len(faulty) else None)
     return tolerance * _column_max(S) + ATOL, S, U, W, ks
 
 
