@@ -16,13 +16,17 @@ that were neither decided nor checked), per kind as well:
   sign, fmin/fmax, atan2 at their kinks) through ``prove_identity``, each verdict re-checked by
   CasADi's own evaluation (:func:`~uvsym.verify.borderline.c_semantics_unsound`).
 
-``python benchmarks/soundness.py COUNT KIND`` runs one kind only, into ``soundness_<kind>.json``.
+``python benchmarks/soundness.py COUNT KIND`` runs one kind only, into ``soundness_<kind>.json``;
+the C-semantics kind also counts the cases using each operation (``per_operation_min``: at least
+1,000 of each is the target; ``python benchmarks/soundness.py 6000 c_semantics`` reaches it).
 """
 
 from __future__ import annotations
 
+import os
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +35,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common import finish  # noqa: E402
 
-from uvsym.verify.borderline import c_semantics_cases, c_semantics_unsound, identity_cases, linear_cases, region_cases
+from uvsym.verify.borderline import (
+    C_OPERATIONS,
+    c_semantics_cases,
+    c_semantics_unsound,
+    identity_cases,
+    linear_cases,
+    operations,
+    region_cases,
+)
 from uvsym.verify.enclosure_check import BINARY, BOX_KINDS, OPERATIONS, enclosure_violations, random_box
 from uvsym.verify.identity import prove_identity
 from uvsym.verify.lyapunov import discrete_lyapunov_decrease, lyapunov_decrease
@@ -102,18 +114,43 @@ def identity_kind(count: int) -> dict:
     return result
 
 
-def c_semantics_kind(count: int) -> dict:
-    started, outcomes, examples = time.perf_counter(), [], []
-    cases = c_semantics_cases(count, seed=104)
-    for case in cases:
-        certificate = prove_identity(case.kind, case.lhs, case.rhs, case.inputs, "the reals", symbolic_seconds=1.0)
+def _c_semantics_verdicts(count: int, shard: int, shards: int) -> list[tuple[str, str | None]]:
+    """Status (or "missed") and the C check's objection for every ``shards``-th case from ``shard``."""
+    verdicts = []
+    for case in c_semantics_cases(count, seed=104)[shard::shards]:
+        try:
+            certificate = prove_identity(case.kind, case.lhs, case.rhs, case.inputs, "the reals",
+                                         symbolic_seconds=1.0)
+        except Exception as exc:  # a raw exception is a finding too (counted as crashed), not the end of the run
+            verdicts.append(("crashed", f"{case.kind}: {type(exc).__name__}: {str(exc)[:200]}"))
+            continue
         why = c_semantics_unsound(case, certificate)
         # a verdict the C check rejects is unsound whatever the generator's truth
-        outcomes.append(("missed" if why else certificate.status, case.holds))
-        examples += [why] if why else []
-    result = _tally(outcomes, time.perf_counter() - started, examples[:5])
+        verdicts.append(("missed" if why else certificate.status, why))
+    return verdicts
+
+
+def c_semantics_kind(count: int) -> dict:
+    """The C-semantics identities, on every processor (each case is independent); counts by the
+    generator's class and by the operations (``C_OPERATIONS``) each case uses."""
+    started, shards = time.perf_counter(), os.cpu_count() or 1
+    with ProcessPoolExecutor(shards) as pool:
+        parts = list(pool.map(_c_semantics_verdicts, [count] * shards, range(shards), [shards] * shards))
+    cases = c_semantics_cases(count, seed=104)
+    verdicts = [None] * count
+    for shard, part in enumerate(parts):
+        verdicts[shard::shards] = part
+    outcomes = [(status, case.holds) for case, (status, _) in zip(cases, verdicts)]
+    result = _tally(outcomes, time.perf_counter() - started, [why for _, why in verdicts if why][:5])
     result["by_class"] = {kind: {s: sum(1 for c, (st, _) in zip(cases, outcomes) if c.kind == kind and st == s)
                                  for s in result["statuses"]} for kind in dict.fromkeys(c.kind for c in cases)}
+    used = [operations(case) for case in cases]
+    result["by_operation"] = {op: {"cases": sum(op in u for u in used),
+                                   "unsound": sum(op in u and st == "missed" for u, (st, _) in zip(used, verdicts)),
+                                   "crashed": sum(op in u and st == "crashed" for u, (st, _) in zip(used, verdicts))}
+                              for op in C_OPERATIONS.values()}
+    result["per_operation_min"] = min(v["cases"] for v in result["by_operation"].values())
+    result["crashed"] = sum(status == "crashed" for status, _ in verdicts)
     return result
 
 
@@ -136,7 +173,12 @@ def main(count: int = 1000, only: str | None = None) -> dict:
                / max(1, sum(k["cases"] for k in claims)),
                "generated_per_kind": count, "kinds": kinds}
     path = RESULTS if only is None else RESULTS.with_name(f"soundness_{only}.json")
-    return finish(results, {"unsound_max": 0, "generated_per_kind_min": 1000}, path)
+    targets = {"unsound_max": 0, "generated_per_kind_min": 1000}
+    if "c_semantics" in kinds:
+        results["per_operation_min"] = kinds["c_semantics"]["per_operation_min"]
+        results["crashed"] = kinds["c_semantics"]["crashed"]
+        targets |= {"per_operation_min": 1000, "crashed_max": 0}
+    return finish(results, targets, path)
 
 
 if __name__ == "__main__":

@@ -79,3 +79,14 @@ def test_the_true_class_holds_in_c_on_the_grid():
     for case in c_semantics_cases(len(C_SEMANTICS) * 2, seed=5):
         differs = any(_differs(case.lhs, case.rhs, (a, b), case.inputs) for a in C_GRID for b in C_GRID)
         assert differs != case.holds, case.kind
+
+
+def test_a_difference_whose_conditions_sympy_cannot_print_is_inconclusive_not_a_crash():
+    """Found by the generated suite (benchmarks/soundness.py): fmod and copysign nested in the divisor sign class,
+    whose converted conditions sympy rewrites into if-then-else terms its mpmath printer rejects (TypeError)."""
+    a = ca.fmod(ca.copysign(x * y - 1.5, y), (ca.sign(2 * x - y - 1.5) * (y - 1.5)) ** 2 + 1)
+    lhs, rhs = ca.fmod(a, -((y - 1.5) ** 2 + 1)), ca.fmod(a, (y - 1.5) ** 2 + 1)  # true in C for all x, y
+    certificate = prove_identity("fmod divisor sign", lhs, rhs, [x, y], "the reals", symbolic_seconds=1.0)
+    assert certificate.status in ("proved", "inconclusive")
+    if certificate.status == "inconclusive":
+        assert "cannot print" in certificate.reason or "timed out" in certificate.reason

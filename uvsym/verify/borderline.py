@@ -36,7 +36,7 @@ import mpmath
 import numpy as np
 
 __all__ = ["IdentityCase", "LinearCase", "RegionCase", "c_semantics_cases", "identity_cases", "linear_cases",
-           "region_cases", "C_GRID", "C_SEMANTICS", "c_semantics_unsound"]
+           "region_cases", "C_GRID", "C_OPERATIONS", "C_SEMANTICS", "c_semantics_unsound", "operations"]
 
 _TRANSCENDENTAL = {"sin": (ca.sin, mpmath.sin), "tanh": (ca.tanh, mpmath.tanh),
                    "expm1": (lambda x: ca.exp(x) - 1, mpmath.expm1)}
@@ -262,12 +262,24 @@ C_SEMANTICS = tuple(_c_true(0, 0)) + tuple(_c_false(ca.SX.sym("x"), ca.SX.sym("y
 
 
 def _expression(rng, x, y, depth: int):
-    """A random expression of x and y over +, -, *, fabs, sign, floor, fmod, copysign, fmin, fmax."""
+    """A random expression of x and y over +, *, fabs, sign, floor, ceil, fmod, copysign, fmin, fmax, atan2."""
     if depth == 0 or rng.uniform() < 0.3:
         return [x, y, x + y, 2 * x - y, x * y][int(rng.integers(5))] + float(rng.choice([0.0, 0.5, -1.5]))
     a, b = _expression(rng, x, y, depth - 1), _expression(rng, x, y, depth - 1)
-    return [a + b, a * b, ca.fabs(a), ca.sign(a) * b, ca.floor(a), ca.fmod(a, b * b + 1), ca.copysign(a, b),
-            ca.fmin(a, b), ca.fmax(a, b)][int(rng.integers(9))]
+    return [a + b, a * b, ca.fabs(a), ca.sign(a) * b, ca.floor(a), ca.ceil(a), ca.fmod(a, b * b + 1),
+            ca.copysign(a, b), ca.fmin(a, b), ca.fmax(a, b), ca.atan2(a, b)][int(rng.integers(11))]
+
+
+C_OPERATIONS = {ca.OP_FMOD: "fmod", ca.OP_COPYSIGN: "copysign", ca.OP_FLOOR: "floor", ca.OP_CEIL: "ceil",
+                ca.OP_SIGN: "sign", ca.OP_FABS: "fabs", ca.OP_FMIN: "fmin", ca.OP_FMAX: "fmax",
+                ca.OP_ATAN2: "atan2"}  # CasADi's operations whose C meaning differs from the textbook one at a kink
+
+
+def operations(case: IdentityCase) -> set[str]:
+    """The operation classes of :data:`C_OPERATIONS` that either side of ``case`` uses."""
+    sides = ca.Function("sides", list(case.inputs), [case.lhs, case.rhs])
+    return {C_OPERATIONS[op] for op in map(sides.instruction_id, range(sides.n_instructions()))
+            if op in C_OPERATIONS}
 
 
 def c_semantics_cases(count: int, seed: int = 0) -> list[IdentityCase]:

@@ -249,10 +249,13 @@ def prove_identity(claim: str, lhs: ca.SX, rhs: ca.SX, inputs: list[ca.SX], set_
     try:
         numeric = sp.lambdify(sym, entries, modules="mpmath")
         magnitude = sp.lambdify(sym, sizes, modules="mpmath")
-    except RecursionError:  # sympy's printer recurses once per level of nesting
+    except (RecursionError, TypeError) as exc:  # the printer recurses once per level of nesting, and cannot print
+        # a condition sympy rewrote into nested if-then-else terms with piecewise arguments (TypeError)
+        why = ("is nested too deeply for sympy to print it" if isinstance(exc, RecursionError)
+               else "has conditions sympy cannot print")
         return certificate("sampling by mpmath", "inconclusive",
                            reason=f"{'not shown zero symbolically' if outcome == '' else 'symbolic steps timed out'}; "
-                                  "the difference is nested too deeply for sympy to print it for mpmath")
+                                  f"the difference {why} for mpmath")
 
     def relative(point, digits):
         with mpmath.workdps(digits):
