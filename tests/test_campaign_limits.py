@@ -48,3 +48,12 @@ def test_missing_columns_are_named():
         channel_limits([_row(1.0, True)], "e")
     with pytest.raises(CampaignError, match="no grid field 'sigma'"):
         false_alarm_rates([_row(1.0, True)], "sigma", "d")
+
+
+def test_a_size_function_measures_factors_from_one_and_leaves_out_what_it_gives_none():
+    rows = [dict(_row(0.8, True, 1.0), true_kind="proportional"), dict(_row(0.5, True, 2.0), true_kind="proportional"),
+            dict(_row(20.0, True, 3.0), true_kind="constant")]
+    limits = channel_limits(rows, "d", size=lambda r: abs(1 - r["true_value"]) if r["true_kind"] == "proportional"
+                            else None)
+    assert [(item["kind"], [s for s, _, _ in item["sizes"]]) for item in limits] == [("proportional",
+                                                                                      [pytest.approx(0.2), 0.5])]

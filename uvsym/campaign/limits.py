@@ -29,10 +29,12 @@ def _column(rows: list[dict], detector: str | None, metric: str):
     return lambda row: row.get(key)
 
 
-def channel_limits(rows: list[dict], detector: str | None = None, cases=None) -> list[dict]:
+def channel_limits(rows: list[dict], detector: str | None = None, cases=None, size=None) -> list[dict]:
     """One dict per (channel, kind) with a fault (module docstring): channel, kind, sizes (list of
     (size, runs, detected)), seen_from, missed_up_to, median_delay_s; ``cases``: the case names to read
-    (None: every case). Runs that ended in an error are left out."""
+    (None: every case); ``size``: row -> the fault's size (default ``|true_value|``; None leaves the run
+    out, e.g. a kind whose value is no size). Runs that ended in an error are left out."""
+    size = size or (lambda row: abs(row["true_value"]))
     detected, delay = _column(rows, detector, "detected"), _column(rows, detector, "detection_delay_s")
     groups: dict[tuple, dict[float, list]] = {}
     for row in rows:
@@ -41,7 +43,9 @@ def channel_limits(rows: list[dict], detector: str | None = None, cases=None) ->
         channel = row.get("true_actuator") or row.get("true_sensor")
         if channel is None or row.get("true_value") is None:
             continue
-        groups.setdefault((channel, row["true_kind"]), {}).setdefault(abs(row["true_value"]), []).append(row)
+        magnitude = size(row)
+        if magnitude is not None:
+            groups.setdefault((channel, row["true_kind"]), {}).setdefault(magnitude, []).append(row)
     limits = []
     for (channel, kind), by_size in sorted(groups.items()):
         sizes = [(size, len(runs), sum(bool(detected(r)) for r in runs)) for size, runs in sorted(by_size.items())]
