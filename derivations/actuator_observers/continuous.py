@@ -18,6 +18,7 @@ from derivations.actuator_observers.campaign import CAMPAIGN, correct, counts, s
 from derivations.actuator_observers.dock import cross_track_rms, dock_miss
 from derivations.actuator_observers.figures import campaign_confusion_figure, campaign_delay_figure
 from uvsym.campaign import load_campaign, run_campaign
+from uvsym.campaign.limits import channel_limits, false_alarm_rates
 from uvsym.progress import ProgressBar
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import simulate_scenario
@@ -33,6 +34,19 @@ TABLE_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", 
 
 def _vehicle(case: str) -> str:
     return case.split(",")[0]
+
+
+def fault_size(row: dict) -> float | None:
+    """A fault's size for the limits: a proportional factor's distance from 1, a bias's magnitude; a stuck
+    actuator's value is no size (how much it matters depends on the commands), so None."""
+    if row["true_kind"] == "proportional":
+        return abs(1.0 - row["true_value"])
+    return abs(row["true_value"]) if row["true_kind"] == "bias" else None
+
+
+def _noisy(faults) -> bool:
+    """Whether a run's ``faults`` grid field (a list, or its text in a results table) holds sensor noise."""
+    return bool(faults) and faults != "[]"
 
 
 def _decided(row: dict) -> str:
@@ -67,7 +81,13 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     _write_table(rows, out_dir / "campaign_results.csv")
     campaign_confusion_figure(confusion, out_dir / "campaign_confusion.svg")
     campaign_delay_figure(counted, out_dir / "campaign_delays.svg")
+    limits = {vehicle: channel_limits(rows, cases=[c for c in dict.fromkeys(r["case"] for r in rows)
+                                                   if _vehicle(c) == vehicle], size=fault_size)
+              for vehicle in dict.fromkeys(_vehicle(r["case"]) for r in rows)}
+    for row in rows:
+        row["velocity_noise"] = "told" if "sensor noise" in row["case"] or _noisy(row.get("faults")) else "none"
     return {**figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
+            "limits": limits, "fault_free": false_alarm_rates(rows, "velocity_noise"),
             "size_intervals": size_intervals(rows),
             "excluded": [{"vehicle": v, "actuator": a, "kind": k, "runs": n}
                          for (v, a, k), n in sorted(excluded.items())],

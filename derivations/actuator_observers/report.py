@@ -6,6 +6,7 @@ import casadi as ca
 
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
 from derivations.papers import paper
+from uvsym.campaign.limits import false_alarm_table, limits_table
 from uvsym.report import markdown_table
 from uvsym.report.sections import c_section, claims_table, counterexamples
 from uvsym.sim.scenario import Scenario
@@ -197,6 +198,38 @@ end with correction: {_fmt(second['final_depth_error_m_with_ftc'], 3)} m.
 """
 
 
+def limits_section(f: dict) -> str:
+    """The diagnosis's limits read off the campaign: smallest fault seen per actuator, false alarms per hour."""
+    tables = "\n\n".join(f"{vehicle}:\n\n" + markdown_table(
+        ["actuator", "fault kind", "sizes tried: detected / runs", "detected in every run from", "missed at",
+         "median delay (s)"], limits_table(limits)) for vehicle, limits in f["limits"].items())
+    healthy = f["fault_free"]
+    hours = sum(r["hours"] for r in healthy)
+    return f"""### Limits (from the campaign)
+
+Fault sizes are a proportional fault's distance from a factor of 1 and a bias's magnitude (N, rpm or rad);
+a stuck actuator's value is no size (what it hides depends on the commands), so stuck faults are left
+out here. Each size was tried in a handful of runs (two onsets, with and without noise), so "detected in
+every run from" brackets the smallest detectable fault between the sizes tried; the campaign does not
+search below them.
+
+{tables}
+
+False alarms of fault-free runs (velocity noise told to the diagnosis, or none):
+
+{markdown_table(["velocity noise", "fault-free hours", "false alarms", "per hour"], false_alarm_table(healthy))}
+
+Only {hours:.2g} fault-free hours were run ({f["campaign_false_alarms_before_onset"]} false alarms before
+the onsets of the faulty runs besides): far too few to confirm a designed rate of the order of one per
+hour, which needs at least 10 h per setting; the diagnosis's fits take far longer than the simulation,
+so ten hours per setting would dominate the report's build, and the study does not run them.
+
+What the diagnosis cannot see, by construction: a fault of an actuator
+whose command stays put after the onset (proportional, bias and stuck faults then act alike: the
+unexcited runs above), a proportional fault while its command is near zero, and a fault on an actuator
+whose column of B is parallel to another's (no measurement tells the two apart: ambiguous)."""
+
+
 def continuous_section(c: dict) -> str:
     """The section on uvsym's continuous diagnosis: the fault campaign and the corrected docking run."""
     f, d = c["campaign"], c["docking"]
@@ -268,6 +301,8 @@ put makes proportional, bias and stuck faults act alike, and a command near zero
 proportional fault):
 
 {markdown_table(["vehicle", "actuator", "fault kind", "runs"], excluded) if excluded else "none."}
+
+{limits_section(f)}
 
 ### The docking run with the continuous diagnosis correcting it (`uvsym simulate docking_diagnosis`)
 
