@@ -57,7 +57,7 @@ def test_containment_inside_and_just_outside():
 def test_reduction_always_encloses(n, extra, seed, method, data):
     Z = _random_zonotope(seed, n, n + extra)
     target = data.draw(st.integers(n, n + extra))
-    reduced = reduce(Z, target, method)
+    reduced = reduce(Z, target, method, coefficients=True)
     Zr, R = reduced.zonotope, reduced.coefficients
     assert Zr.order <= target
     np.testing.assert_allclose(Zr.center, Z.center)
@@ -143,9 +143,9 @@ def test_compiled_box_reduction_equals_the_numpy_path(method, monkeypatch):
     if kernel.box_reduce(np.eye(2), 2, False) is None:
         pytest.skip("no C compiler: only the numpy path exists")
     Z = _random_zonotope(11, 6, 200)
-    compiled = reduce(Z, 30, method)
+    compiled = reduce(Z, 30, method, coefficients=True)
     monkeypatch.setattr(reduction, "box_reduce", lambda *args, **kwargs: None)
-    reference = reduce(Z, 30, method)
+    reference = reduce(Z, 30, method, coefficients=True)
     np.testing.assert_allclose(compiled.zonotope.generators, reference.zonotope.generators, rtol=1e-14)
     np.testing.assert_allclose(compiled.coefficients, reference.coefficients, rtol=1e-14)
     assert reduce(Z, 30, method, coefficients=False).coefficients is None
@@ -256,7 +256,7 @@ def test_reduction_skips_an_empty_axis(compiled, monkeypatch):
 
     if not compiled:
         monkeypatch.setattr(reduction, "box_reduce", lambda *args, **kwargs: None)
-    reduced = reduce(Zonotope([0.0, 0.0], [[1.0, 0.1, 0.2], [0.0, 0.0, 0.0]]), 2)
+    reduced = reduce(Zonotope([0.0, 0.0], [[1.0, 0.1, 0.2], [0.0, 0.0, 0.0]]), 2, coefficients=True)
     np.testing.assert_allclose(reduced.zonotope.generators, [[1.3], [0.0]], rtol=1e-15)
     np.testing.assert_allclose(reduced.coefficients, [[1 / 1.3, 0.1 / 1.3, 0.2 / 1.3]], rtol=1e-15)
 
@@ -341,8 +341,8 @@ def test_noise_set_of_the_wrong_dimension_is_named_in_lower_case():
 def test_reduction_within_the_order_forms_no_map_unless_asked():
     """3 generators under an order bound of 5: nothing is reduced, R = I (3, 3) only when asked for."""
     Z = Zonotope([0.0, 0.0], [[1.0, 0.0, 2.0], [0.0, 1.0, -1.0]])
-    assert reduce(Z, 5, coefficients=False).coefficients is None
-    np.testing.assert_array_equal(reduce(Z, 5).coefficients, np.eye(3))
+    assert reduce(Z, 5).coefficients is None
+    np.testing.assert_array_equal(reduce(Z, 5, coefficients=True).coefficients, np.eye(3))
 
 
 def test_centre_must_be_a_vector():
@@ -370,7 +370,7 @@ def test_a_numpy_integer_order_is_accepted_and_exactly_the_order_reduces_nothing
     reduced (R = I), whereas a bound of 2 boxes them into (1 + 2 + 0.5, 1 + 1 + 0.3) = (3.5, 2.3)."""
     G = np.array([[1.0, 2.0, 0.5], [1.0, -1.0, 0.3]])
     Z = Zonotope([0.0, 0.0], G)
-    same = reduce(Z, np.int64(3))
+    same = reduce(Z, np.int64(3), coefficients=True)
     np.testing.assert_array_equal(same.zonotope.generators, G)
     np.testing.assert_array_equal(same.coefficients, np.eye(3))
     np.testing.assert_allclose(reduce(Z, np.int64(2), "girard").zonotope.generators, np.diag([3.5, 2.3]),
@@ -391,8 +391,8 @@ def test_box_reductions_use_the_compiled_kernel_when_one_is_built(monkeypatch):
     monkeypatch.setattr(reduction, "box_reduce", spy)
     Z = _random_zonotope(12, 3, 9)
     for method in ("girard", "combastel", "pca"):
-        reduce(Z, 4, method)
-    reduce(Z, 4, coefficients=False)
+        reduce(Z, 4, method, coefficients=True)
+    reduce(Z, 4)  # the default: no map
     # (combastel flag, whether the kernel returns the replaced mask for R); PCA has no compiled path
     assert calls == [(False, True), (True, True), (False, False)]
 

@@ -40,9 +40,10 @@ class Reduction:
     coefficients: np.ndarray | None
 
 
-def reduce(zonotope: Zonotope, generators: int, method: str = "girard", coefficients: bool = True) -> Reduction:
+def reduce(zonotope: Zonotope, generators: int, method: str = "girard", coefficients: bool = False) -> Reduction:
     """The zonotope with at most ``generators`` generators enclosing ``zonotope`` (module docstring);
-    with ``coefficients=False`` the map R is not formed (``Reduction.coefficients`` is None).
+    with ``coefficients=True`` also the map R (``Reduction.coefficients``; None without it: forming R
+    costs more than the reduction, and only carrying a point's coefficients needs it).
 
     Raises
     ------
