@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.errors import ObserverError
 from uvsym.faults import actuator_kind
 from uvsym.observers.actuator import ActuatorObserver
@@ -83,7 +84,15 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
         if actuator_kind(observer.kind).scales:
             raise ObserverError(f"the {observer.kind} observer's rate depends on tau_d: pass the nominal tau_d")
         tau_d = np.ones(n)
-    tau_d = _desired_action(tau_d, n)
+    return _designed(observer, float(time_constant), tuple(_desired_action(tau_d, n).tolist()))
+
+
+@memoized(64)
+def _designed(observer: ActuatorObserver, time_constant: float, tau_d: tuple) -> GainDesign:
+    """:func:`design_gains` for checked arguments (memoized in-process: a campaign's scenarios share it),
+    its arrays read-only."""
+    n = len(tau_d)
+    tau_d = np.array(tau_d)
     unobservable = unobservable_channels(observer, tau_d)
     if len(unobservable) == n:
         raise ObserverError(f"tau_d = {tau_d.tolist()} is zero in every channel: the {observer.kind} observer sees "
@@ -95,4 +104,6 @@ def design_gains(observer: ActuatorObserver, time_constant: float, tau_d=None) -
         if i not in unobservable:
             K[i] = 1.0 / (time_constant * per_unit_gain[i])
     rates = np.sort(-np.linalg.eigvals(np.asarray(observer.error_matrix(tau_d, K))).real)
+    K.setflags(write=False)
+    rates.setflags(write=False)
     return GainDesign(K=K, rates=rates, unobservable=unobservable)
