@@ -119,7 +119,7 @@ def execute_many(runs: list[Run], settings: Settings, hook=None) -> list[dict]:
         started = time.perf_counter()
         try:
             results = simulate_batch([scenario for _, scenario in members], compiled=options.get("compiled", True),
-                                     substeps=options.get("substeps", 1))
+                                     substeps=options.get("substeps", 1), current_in_step=False)
             batch = []
             for (i, scenario), result in zip(members, results):
                 row = _base(runs[i]) | truth(scenario)

@@ -56,7 +56,7 @@ def default_lanes() -> int:
 
 
 def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: int = 1, compiled: bool = True,
-                   supervisor=None) -> list[SimResult]:
+                   supervisor=None, current_in_step: bool = True) -> list[SimResult]:
     """Each scenario run as :func:`simulate_scenario` (method ``fast``; for a SystemScenario
     :func:`~uvsym.sim.system_scenario.simulate_system_scenario`, whose own substeps hold) would, in
     lanes of shared compiled steps.
@@ -65,7 +65,9 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
     of one scenario, do), have equal controllers, observers, sensor faults, step and duration;
     each such group runs in lanes (``lanes`` per compiled step; None: :func:`default_lanes`). Results are
     in the order of ``scenarios``; meta as :func:`simulate_scenario`'s plus ``lanes``, ``wall_s`` being the
-    group's.
+    group's. current_in_step: build a constant current the group shares into its step (fewer operations);
+    False reads it from each run's inputs, so that calls with other currents share the step and its compiled
+    library (a campaign's chunks).
 
     Raises
     ------
@@ -102,7 +104,8 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
         observers = observer_blocks(first.model, first.observers, first.step)
         loop = build_closed_loop(first.model, first.controller, first.step, sensor_faults=first.sensor_faults,
                                  observers=observers, substeps=substeps,
-                                 current=_shared_current([scenarios[i] for i in members]))
+                                 current=_shared_current([scenarios[i] for i in members]) if current_in_step
+                                 else None)
         runs = [prepare_run(scenarios[i].model, scenarios[i].controller, **scenario_arguments(scenarios[i], observers),
                             substeps=substeps, loop=loop) for i in members]
         names = [scenarios[i].name for i in members]
