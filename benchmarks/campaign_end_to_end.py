@@ -21,11 +21,13 @@ The load average before each repeat and the processor's vector width are recorde
 
 from __future__ import annotations
 
+import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -67,10 +69,7 @@ def _kernel_step_s() -> tuple[float, int]:
     from uvsym.sim.simulation import observer_blocks, prepare_run, scenario_arguments
 
     lanes = default_lanes()
-    scenario = load_scenario("docking_faults")
-    from dataclasses import replace
-
-    scenario = replace(scenario, duration=DURATION)
+    scenario = replace(load_scenario("docking_faults"), duration=DURATION)
     observers = observer_blocks(scenario.model, scenario.observers, scenario.step)
     loop = build_closed_loop(scenario.model, scenario.controller, scenario.step,
                              sensor_faults=scenario.sensor_faults, observers=observers)
@@ -88,8 +87,6 @@ def _kernel_step_s() -> tuple[float, int]:
 
 
 def main(runs: int = 1000, repeats: int = 3) -> dict:
-    import os
-
     from uvsym.codegen.compile import vector_doubles
     from uvsym.sim.scenario import load_scenario
 

@@ -73,15 +73,20 @@ def execute(run: Run, settings: Settings, hook=None) -> dict:
         scenario = parse_any_scenario(run.scenario)
         row |= truth(scenario)
         result = simulate_any_scenario(scenario, **(dict(settings.simulation) | dict(run.simulation)))
-        events = list(getattr(result, "events", None) or [])
-        row |= run_metrics(scenario, result, events)
-        if hook is not None:
-            row |= _hook_columns(hook(scenario, result, events), settings.metrics, row)
-        row |= {"status": "ok", "error": None}
+        _measure(row, scenario, result, settings, hook)
     except Exception as exc:  # a run that fails is a row, not the end of the campaign
         row |= {"status": "error", "error": f"{type(exc).__name__}: {exc}"}
     row["wall_s"] = time.perf_counter() - started
     return row
+
+
+def _measure(row: dict, scenario, result, settings: Settings, hook) -> None:
+    """Add a finished run's metrics, the hook's columns and status "ok" to ``row`` (its base and truth)."""
+    events = list(getattr(result, "events", None) or [])
+    row |= run_metrics(scenario, result, events)
+    if hook is not None:
+        row |= _hook_columns(hook(scenario, result, events), settings.metrics, row)
+    row |= {"status": "ok", "error": None}
 
 
 def _lane_ready(scenario, options: dict) -> bool:
@@ -123,11 +128,8 @@ def execute_many(runs: list[Run], settings: Settings, hook=None) -> list[dict]:
             batch = []
             for (i, scenario), result in zip(members, results):
                 row = _base(runs[i]) | truth(scenario)
-                events = list(getattr(result, "events", None) or [])
-                row |= run_metrics(scenario, result, events)
-                if hook is not None:
-                    row |= _hook_columns(hook(scenario, result, events), settings.metrics, row)
-                batch.append((i, row | {"status": "ok", "error": None}))
+                _measure(row, scenario, result, settings, hook)
+                batch.append((i, row))
         except Exception:  # one run's failure: each run alone, for its own row
             for i, _ in members:
                 rows[i] = execute(runs[i], settings, hook)

@@ -140,10 +140,12 @@ def frozen(value):
     return _Same(value)
 
 
-def memoized(maxsize: int):
+def memoized(maxsize: int, key=None):
     """Decorator: keep the results of the last ``maxsize`` distinct calls, keyed by :func:`frozen` of the
-    arguments (so a changed parameter, gain or fault is a new call). For pure builders of immutable
-    results; ``f.cache_clear()`` empties the memo."""
+    arguments (so a changed parameter, gain or fault is a new call), or of ``key(*args, **kwargs)``: what the
+    builder reads of them, where freezing a whole argument would cost more than it saves. For pure builders
+    of immutable results; ``f.cache_clear()`` empties the memo."""
+    key_of = key
 
     def decorate(function):
         cache: OrderedDict = OrderedDict()
@@ -151,7 +153,7 @@ def memoized(maxsize: int):
 
         @functools.wraps(function)
         def wrapper(*args, **kwargs):
-            key = frozen((args, tuple(sorted(kwargs.items()))))
+            key = frozen(key_of(*args, **kwargs) if key_of else (args, tuple(sorted(kwargs.items()))))
             with lock:
                 if key in cache:
                     cache.move_to_end(key)

@@ -32,6 +32,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.checked import checked
+from uvsym.codegen.cache import memoized
 from uvsym.conventions import FORCE_LABELS, POSITION_LABELS, VELOCITY_LABELS
 from uvsym.errors import ObserverError
 from uvsym.faults import ActuatorKind, actuator_kind
@@ -65,10 +66,6 @@ class ActuatorObserver:
     error_dynamics: ca.Function
 
 
-_BUILT: dict[tuple, tuple] = {}  # what actuator_observer built, by what it reads of the model: (h, observer)
-_KEPT = 64
-
-
 def actuator_observer(model: Model, kind: str, form: str = "paper",
                       require_assumption_1: bool = True) -> ActuatorObserver:
     """Build the observer of ``kind`` (proportional, bias, constant) for ``model``; memoized in-process by
@@ -92,18 +89,12 @@ def actuator_observer(model: Model, kind: str, form: str = "paper",
         raise ObserverError(f"unknown observer kind {kind!r}; known: {', '.join(KINDS)}")
     if form not in FORMS:
         raise ObserverError(f"unknown observer form {form!r}; known: {', '.join(FORMS)}")
-    key = (model.name, model.M.tobytes(), model.M.shape, id(model.h), kind, form, bool(require_assumption_1))
-    if key in _BUILT and _BUILT[key][0] is model.h:
-        return _BUILT[key][1]
-    observer = _build(model, kind, form, require_assumption_1)
-    if len(_BUILT) >= _KEPT:
-        _BUILT.pop(next(iter(_BUILT)))
-    _BUILT[key] = (model.h, observer)  # h held, so that its id is not reused while kept
-    return observer
+    return _build(model, kind, form, bool(require_assumption_1))
 
 
+@memoized(64, key=lambda model, kind, form, require: (model.name, model.M, model.h, kind, form, require))
 def _build(model: Model, kind: str, form: str, require_assumption_1: bool) -> ActuatorObserver:
-    """:func:`actuator_observer`, built (its arguments checked)."""
+    """:func:`actuator_observer`, built (its arguments checked); memoized by what it reads of the model."""
     M = model.M
     coupled = not np.allclose(M, np.diag(np.diag(M)), rtol=0, atol=1e-12)
     if require_assumption_1 and actuator_kind(kind).scales and form == "paper" and coupled:
