@@ -13,7 +13,15 @@ from scipy.stats import chi2
 
 from derivations.sensor_fdi_lms import DERIVATION
 from uvsym.errors import ObserverError, ScenarioError
-from uvsym.observers.step_monitor import sensor_step_monitor, step_models, step_threshold
+from uvsym.observers.step_monitor import (
+    AFTER,
+    BEFORE,
+    GLITCH,
+    sensor_step_monitor,
+    step_models,
+    step_power,
+    step_threshold,
+)
 from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
 from uvsym.systems.signals import signals
 
@@ -42,13 +50,14 @@ def test_the_threshold_is_the_chi_square_two_quantile_of_the_designed_rate():
         step_threshold(1e9, 1.0)
 
 
+@pytest.mark.parametrize("window", [(10, 8), (BEFORE, AFTER)])
 @pytest.mark.parametrize("truth", ["trend", "kink", "glitch"])
-def test_false_confirmations_stay_below_the_chi_square_bound(truth):
+def test_false_confirmations_stay_below_the_chi_square_bound(truth, window):
     """Monte Carlo under each healthy model: P(g > h) <= exp(-h / 2) at a low h (4, bound 0.135),
     where exceedances are frequent enough to count."""
-    models = step_models(10, 8, 3)
+    models = step_models(*window, 3)
     rng = np.random.default_rng(7)
-    W, runs = 18, 20000
+    W, runs = sum(window), 20000
     i = np.arange(W)
     base = rng.normal(0, 1, (runs, 3)) @ np.vstack([np.ones(W), i / W, (i / W) ** 2])
     if truth == "kink":
@@ -61,6 +70,42 @@ def test_false_confirmations_stay_below_the_chi_square_bound(truth):
     best = np.max([np.sum((v @ Q) ** 2, axis=1) for Q in models["healthy"]], axis=0)
     g = explained - best
     assert np.mean(g > 4.0) <= math.exp(-2.0)
+
+
+@pytest.mark.parametrize("window", [(10, 8, 3), (BEFORE, AFTER, GLITCH), (30, 25, 4)])
+def test_the_statistic_s_one_column_form_is_the_least_squares_difference(window):
+    """g sigma^2 = |S^T v|^2 - max_k (c_k^T v)^2 (what the monitor evaluates) equals the RSS of the best
+    healthy model less the step model's, each fitted by least squares on its own columns (numpy's lstsq)."""
+    models = step_models(*window)
+    B, A, L = window
+    W = B + A
+    i, rng = np.arange(W, dtype=float), np.random.default_rng(3)
+    t = (i - B + 0.5) / W
+    trend = [t ** 0, t, t ** 2]
+    candidates = [[]] + [[np.where(i >= p, i - p + 1.0, 0.0)] for p in range(1, W)] + [
+        [((i >= p) & (i < p + n)).astype(float)] for p in range(1, W) for n in range(1, L + 1) if p + n <= W]
+    step = [(i >= B).astype(float), np.where(i >= B, i - B + 1.0, 0.0)]
+
+    def rss(columns, v):
+        X = np.column_stack(trend + columns)
+        return float(np.sum((v - X @ np.linalg.lstsq(X, v, rcond=None)[0]) ** 2))
+
+    for _ in range(5):
+        v = rng.normal(0, 1, W) + rng.normal(0, 3) * step[0] + 0.2 * i + rng.normal(0, 2) * np.maximum(i - 7, 0)
+        by_lstsq = min(rss(c, v) for c in candidates) - rss(step, v)
+        one_column = np.sum((v @ models["step_beyond"]) ** 2) - max(0.0, np.max((v @ models["healthy_beyond"]) ** 2))
+        assert one_column == pytest.approx(by_lstsq, rel=1e-9, abs=1e-9)
+
+
+def test_power_rises_with_the_step_and_the_window_and_stays_off_healthy_records():
+    """The monitor's Monte Carlo power: small steps rarely, large ones nearly always; the longer window
+    confirms smaller steps; a healthy record (steps of ~0) confirms nothing."""
+    short = step_power([5.0, 12.0], dt=0.2, edges=60)["probability"]
+    long = step_power([5.0, 12.0], dt=0.2, before=20, after=20, edges=60)["probability"]
+    assert short[0] < 0.2 and short[1] > 0.8 and long[0] > short[0] + 0.2 and long[1] > 0.95
+    assert step_power([1e-9], dt=0.2, edges=60)["probability"] == [0.0]
+    with pytest.raises(ObserverError, match="size"):
+        step_power([-1.0], dt=0.2)
 
 
 def test_a_turn_is_not_a_step_and_a_long_healthy_record_confirms_nothing():
@@ -82,7 +127,7 @@ def test_a_step_is_confirmed_sized_and_cleared_when_it_steps_back():
     y[150:450] += 20 * SIGMA  # an intermittent bias: on at 150, off at 450, during the turn
     out = _decide(y)
     confirmed = np.flatnonzero(out["confirmed_psi"] > 0.5)
-    assert confirmed.tolist() == [157, 457]  # A = 8 samples after each step
+    assert confirmed.tolist() == [149 + AFTER, 449 + AFTER]  # A samples after each step (its A-th sample)
     assert out["offset_psi"][200] == pytest.approx(20 * SIGMA, abs=3 * SIGMA)
     assert out["fault_psi"][200] == 1 and out["fault_psi"][-1] == 0
     assert np.max(np.abs(out["psi_sub"][160:440] - (y[160:440] - 20 * SIGMA))) < 3 * SIGMA

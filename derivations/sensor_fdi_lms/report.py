@@ -18,7 +18,7 @@ from derivations.sensor_fdi_lms.study import R0_GRID, SIZE_DEG, WITHIN, detectio
 from derivations.sensor_fdi_lms.text import report_text
 from uvsym.errors import SimulationError
 from uvsym.observers.lms import lms_step, mu_bound
-from uvsym.observers.step_monitor import step_models, step_threshold
+from uvsym.observers.step_monitor import step_power, step_threshold
 from uvsym.report import write_json
 from uvsym.report.equations import function_equations
 from uvsym.report.sections import c_package, claim_rows
@@ -35,6 +35,9 @@ TRANSIENT = 10  # samples (2 s) after the switch by which the turn begun on the 
 FTC_SEEDS = tuple(range(8))  # noise seeds of the FTC robustness runs
 BANDWIDTHS = (0.35, D.BANDWIDTH, 1.4)  # rad/s, the proportional law's natural frequencies compared
 STEPS = (D.MU, 1e3, 1e4, 1e5)  # LMS steps compared (the paper's, and larger ones that let the filter learn)
+STEP_POWER_SIZES = (4.0, 6.0, 8.0, 9.0, 10.0, 11.0, 12.0, 14.0, 16.0)  # steps of the power table (noise std)
+STEP_POWER_EDGES = 400  # steps per size in the power Monte Carlo (a probability to about +-0.025)
+STEP_POWER_LEVELS = (0.5, 0.9)  # detection probabilities whose smallest step the report states
 
 
 def _summary(outcome) -> dict:
@@ -112,9 +115,20 @@ def _calibrated(progress) -> dict:
         errors[f"{size:g}"] = [_max_error(Run(size_deg=size, decision="calibrated", seed=seed)) for seed in FTC_SEEDS]
     return {"max_abs_heading_error_deg": errors, "false_alarms_per_hour": D.STEP_FALSE_ALARMS_PER_HOUR,
             "per_test_probability": D.STEP_FALSE_ALARMS_PER_HOUR * D.DT / 3600.0,
-            "threshold": step_threshold(D.STEP_FALSE_ALARMS_PER_HOUR, D.DT),
-            "smallest_step_deg": math.sqrt(step_threshold(D.STEP_FALSE_ALARMS_PER_HOUR, D.DT))
-            * float(step_models(*D.STEP_WINDOW)["step_std"][-1]) * D.COMPASS_NOISE_DEG}
+            "threshold": step_threshold(D.STEP_FALSE_ALARMS_PER_HOUR, D.DT), "window": list(D.STEP_WINDOW),
+            "power": _step_power(progress)}
+
+
+def _step_power(progress) -> dict:
+    """The monitor's detection probability per step size (noise standard deviations; Monte Carlo on flat
+    records, :func:`~uvsym.observers.step_monitor.step_power`) and the smallest sizes of STEP_POWER_LEVELS."""
+    progress(f"calibrated monitor: detection probability over {STEP_POWER_EDGES} steps per size")
+    before, after, glitch = D.STEP_WINDOW
+    power = step_power(STEP_POWER_SIZES, dt=D.DT, false_alarms_per_hour=D.STEP_FALSE_ALARMS_PER_HOUR, before=before,
+                       after=after, glitch=glitch, edges=STEP_POWER_EDGES)
+    reached = {f"{level:g}": next((size for size, p in zip(power["sizes"], power["probability"]) if p >= level), None)
+               for level in STEP_POWER_LEVELS}
+    return {**power, "smallest_size_reaching": reached}
 
 
 def _robustness(progress) -> dict:

@@ -224,7 +224,7 @@ def _lms(fields: Fields, plant: System, dt: float, name: str) -> Block:
 
 
 def _sensor_step(fields: Fields, plant: System, dt: float, name: str) -> Block:
-    from uvsym.observers.step_monitor import sensor_step_monitor
+    from uvsym.observers.step_monitor import AFTER, BEFORE, GLITCH, sensor_step_monitor
 
     measured = _group(plant, _names(fields, "measured", size=1), fields.path, "measurement")
     fields.describe("noise_std", "number", "> 0 (the measured output's unit)", "the [noise] entry of measured")
@@ -232,7 +232,7 @@ def _sensor_step(fields: Fields, plant: System, dt: float, name: str) -> Block:
         raise ScenarioError(f"{fields._name('noise_std')}: not given, and [noise] has no Gaussian entry for "
                             f"{measured.names[0]!r} (the plant's outputs: {', '.join(plant.y.names)}) to default to")
     options = {key: fields.integer(key, default, minimum=0, unit="samples") for key, default in
-               (("before", 10), ("after", 8), ("glitch", 3))}
+               (("before", BEFORE), ("after", AFTER), ("glitch", GLITCH))}
     options |= {"false_alarms_per_hour": fields.number("false_alarms_per_hour", 0.1, positive=True),
                 "alarm_z": fields.number("alarm_z", 3.5, positive=True),
                 "noise_std": fields.number("noise_std", positive=True)}
