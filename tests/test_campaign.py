@@ -321,7 +321,7 @@ def test_metrics_of_a_hand_written_event_log():
                        "isolation_delay_s": pytest.approx(2.5),
                        "identified_value": 10.4, "identified_std": 0.2, "size_error_std": pytest.approx(2.0),
                        "size_error_rel": pytest.approx(0.04), "false_alarms": 1,
-                       "ambiguous": True, "unexcited": False}
+                       "ambiguous": True, "unexplained": False, "clear_delay_s": None, "unexcited": False}
 
 
 def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
@@ -331,6 +331,7 @@ def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
               _event(32.0, "unexcited", "delta_e")]
     metrics = event_metrics(truth_row, events)
     assert metrics["false_alarms"] == 1 and metrics["detection_delay_s"] == pytest.approx(1.0)
+    assert metrics["clear_delay_s"] == pytest.approx(2.0)  # cleared 2 s after the fault's end at 20 s
     assert metrics["identified_value"] == 3.0 and metrics["size_error_rel"] == pytest.approx(0.7)
     assert metrics["identified_std"] is None and metrics["size_error_std"] is None  # no std stated
     assert metrics["isolated_target"] is None and metrics["unexcited"] is True
@@ -339,6 +340,23 @@ def test_alarms_after_a_fault_ends_and_is_cleared_are_false():
     metrics = event_metrics(healthy, [_event(3.0, "detected"), _event(4.0, "isolated", "X", "bias")])
     assert metrics["false_alarms"] == 2 and metrics["detected"] is False and metrics["detection_delay_s"] is None
     assert metrics["isolated_target"] == "X"
+
+
+def test_the_return_to_no_fault_after_a_fault_ends_and_an_unexplained_record():
+    """clear_delay_s: from the fault's end until no alarm stands (0 when none stands at the end); none for a
+    fault that lasts the run or an alarm that stands to the end; unexplained: any such event."""
+    ends = TRUTH | {"end_s": 20.0}
+    events = [_event(6.0, "detected"), _event(15.0, "cleared"), _event(16.0, "detected"),
+              _event(17.0, "isolated", "X", "bias"), _event(24.5, "cleared", "X")]
+    assert event_metrics(ends, events)["clear_delay_s"] == pytest.approx(4.5)
+    assert event_metrics(ends, events[:4])["clear_delay_s"] is None  # still alarmed at the run's end
+    assert event_metrics(ends, events[:2])["clear_delay_s"] == 0.0  # released before the fault ended
+    assert event_metrics(TRUTH, events)["clear_delay_s"] is None  # the fault lasts the run
+    two = events[:4] + [_event(18.0, "isolated", "delta_ru", "bias"), _event(24.5, "cleared", "X"),
+                        _event(26.0, "cleared", "delta_ru")]
+    assert event_metrics(ends, two)["clear_delay_s"] == pytest.approx(6.0)  # the last standing isolation
+    metrics = event_metrics(ends, [_event(6.0, "unexplained"), _event(30.0, "cleared")])
+    assert metrics["unexplained"] is True and metrics["detected"] is False and metrics["clear_delay_s"] == 0.0
 
 
 def test_the_final_isolation_is_the_last_one_standing():

@@ -22,7 +22,10 @@ RATES = ("runs", "fault_runs", "detection_probability", "missed_detections", "me
 NONE_SEEN = -math.log(0.05)  # none seen in H hours: a Poisson rate below NONE_SEEN / H per hour at 95 %
 SIZE_TOLERANCE = 0.05  # |identified - true| of a delivered fraction that counts as badly sized
 ROW_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "noise.x", "status", "error")
-PER_DETECTOR = ("detected", "detection_delay_s", "isolated_target", "identified_value", "false_alarms")
+PER_DETECTOR = ("detected", "detection_delay_s", "isolated_target", "identified_value", "false_alarms", "clear_delay_s",
+                "isolated_targets", "unexplained")
+ENDING, BOTH = "loss that ends", "both thrusters"  # the cases of a loss that ends and of two losses at once
+RETURN_TARGET_S = 5.0  # s: back to "no fault" after any loss of 5 % or more ends (the issue's target)
 
 
 def _noise(row: dict) -> str:
@@ -47,10 +50,11 @@ def _problems(row: dict, detector: str) -> str | None:
 
 
 def _failures(rows: list[dict], detectors: list[str]) -> list[dict]:
-    """Per faulty run with a problem: the run and, per problem, the detectors that had it."""
+    """Per faulty run with a problem: the run and, per problem, the detectors that had it (runs of one fault
+    that lasts the run: a loss that ends and two losses have their own table, :func:`_returns_section`)."""
     found = []
     for row in rows:
-        if row["status"] != "ok" or not row["n_faults"]:
+        if row["status"] != "ok" or row["n_faults"] != 1 or row["end_s"] is not None:
             continue
         problems: dict[str, list[str]] = {}
         for d in detectors:
@@ -60,6 +64,35 @@ def _failures(rows: list[dict], detectors: list[str]) -> list[dict]:
                    "value": row["true_value"], "noise": _noise(row), "problem": problem, "detectors": names}
                   for problem, names in problems.items()]
     return found
+
+
+def _returns(rows: list[dict], detectors: list[str]) -> dict:
+    """Losses that end: per detector, per run (thruster, delivered fraction) whether it was detected and how
+    long after the end an alarm stood (None: to the end of the run), and the largest such time."""
+    per = {}
+    for d in detectors:
+        runs = [{"thruster": r["true_actuator"], "value": r["true_value"], "detected": bool(r[f"{d}:detected"]),
+                 "return_s": r[f"{d}:clear_delay_s"]} for r in rows]
+        delays = [run["return_s"] for run in runs]
+        finite = [x for x in delays if x is not None]
+        per[d] = {"runs": runs, "never": sum(x is None for x in delays),
+                  "largest_s": None if None in delays or not delays else max(delays),
+                  "largest_finite_s": max(finite) if finite else None}
+    return per
+
+
+def _two_faults(rows: list[dict], detectors: list[str]) -> list[dict]:
+    """Runs with both thrusters losing: the right one's fraction and onset, and per detector what it held at
+    the end (``unexplained``, ``ambiguous``, the thrusters it isolated, or ``nothing``)."""
+    def outcome(row: dict, d: str) -> str:
+        if row[f"{d}:unexplained"]:
+            return "unexplained"
+        if row[f"{d}:ambiguous"]:
+            return "ambiguous"
+        return row[f"{d}:isolated_targets"] or ("detected, nothing isolated" if row[f"{d}:detected"] else "nothing")
+
+    return [{"right_value": r.get("faults[1].value"), "right_onset_s": r.get("faults[1].onset"),
+             "left_value": r["true_value"], "outcomes": {d: outcome(r, d) for d in detectors}} for r in rows]
 
 
 def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict:
@@ -83,6 +116,8 @@ def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict
                                  for d in detectors} for n in dict.fromkeys(_noise(r) for r in rows)},
     }
     figures["failures"] = _failures(rows, detectors)
+    figures["returns"] = _returns([r for r in rows if r["case"] == ENDING and r["status"] == "ok"], detectors)
+    figures["two_faults"] = _two_faults([r for r in rows if r["case"] == BOTH and r["status"] == "ok"], detectors)
     columns = list(ROW_COLUMNS) + [f"{d}:{c}" for d in detectors for c in PER_DETECTOR]
     with (out_dir / "campaign_results.csv").open("w", newline="") as handle:
         writer = csv.writer(handle)
@@ -93,6 +128,50 @@ def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict
 
 def _f(value, digits: int = 3) -> str:
     return "-" if value is None else f"{value:.{digits}g}"
+
+
+def _return_cell(seconds: float | None) -> str:
+    if seconds is None:
+        return "still alarmed at the end"
+    return "released before the end" if seconds == 0.0 else f"{seconds:.2f} s"
+
+
+def _returns_section(c: dict) -> str:
+    """After a loss ends, and two losses at once: the runs per detector, and the targets."""
+    detectors, returns, two = list(c["detectors"]), c["returns"], c["two_faults"]
+    if not returns or not two:
+        return ""
+    first = returns[detectors[0]]["runs"]
+    rows = [[f"{run['thruster']} {run['value']:g}"] + [
+        ("missed, " if not returns[d]["runs"][i]["detected"] else "")
+        + _return_cell(returns[d]["runs"][i]["return_s"]) for d in detectors] for i, run in enumerate(first)]
+    both = [[f"T_L 0.5, T_R {t['right_value']:g} from {t['right_onset_s']:g} s"] + [t["outcomes"][d] for d in detectors]
+            for t in two]
+
+    def verdicts(d: str) -> list[str]:
+        r = returns[d]
+        back = ("met" if r["largest_s"] is not None and r["largest_s"] <= RETURN_TARGET_S else "**missed**")
+        largest = f"{r['largest_s']:.2f} s" if r["largest_s"] is not None else (
+            f"never in {r['never']} run(s)" + (f", else up to {r['largest_finite_s']:.1f} s"
+                                               if r["largest_finite_s"] is not None else ""))
+        culprits = sum(t["outcomes"][d] not in ("unexplained", "ambiguous") for t in two)
+        return [d, largest, back, f"{len(two) - culprits} of {len(two)}", "met" if not culprits else "**missed**"]
+
+    return f"""### After a loss ends, and two losses at once
+
+Losses of 5 % to 80 % (case `{ENDING}`: on from 40 s to 70 s) -- how long after the loss ends an alarm
+still stands ("released before the end": the detector had let the loss go while it lasted):
+
+{markdown_table(["loss (delivered fraction)"] + detectors, rows)}
+
+Both thrusters losing (case `{BOTH}`; the banks model one faulty thruster at a time) -- what each
+detector holds at the end of the run (a single thruster named is a wrong culprit):
+
+{markdown_table(["faults"] + detectors, both)}
+
+{markdown_table(["detector", 'longest return to "no fault" after a loss ends', f"within {RETURN_TARGET_S:g} s",
+                 "two losses: unexplained or ambiguous", "never a single culprit"], [verdicts(d) for d in detectors])}
+"""
 
 
 def campaign_section(c: dict) -> str:
@@ -122,8 +201,9 @@ scenario with both banks in the loop, so the four detectors decide on the same r
 (`rule = "evidence"`, :class:`uvsym.diagnosis.hypotheses.EvidenceSwitch`): a CUSUM of each fault model's
 log-likelihood ratio against the no-fault model, released when the ratio over the last 3 s is no
 longer positive, and `unexplained` when every model's innovations fail their chi-square test,
-thresholds designed for 1 false alarm per hour at the sample period. Faults last to the end of their run (onsets
-drawn in [30, 60] s). A detection counts from the onset on; every alarm event (`detected`,
+thresholds designed for 1 false alarm per hour at the sample period. Faults last to the end of their
+run, but in `loss that ends` and `both thrusters` (below; onsets drawn in [30, 60] s elsewhere). A
+detection counts from the onset on; every alarm event (`detected`,
 `isolated`, `identified`) outside a fault's window is a false alarm, counted over the healthy time
 (healthy runs and the stretches before each onset). Isolation is correct when the thruster isolated
 in the window is the faulty one; the size error is `|identified - true| / true` of the delivered
@@ -144,6 +224,8 @@ False alarms by sensor noise (a multiple of the paper's; the banks keep the pape
 over the healthy runs and the stretches before each onset:
 
 {markdown_table(["noise"] + detectors, healthy)}
+
+{_returns_section(c)}
 
 Where the banks fail (faulty runs on which a detector missed, ended on the wrong thruster, or sized
 the loss more than {SIZE_TOLERANCE:g} off; computed from the runs above):

@@ -28,8 +28,9 @@ __all__ = ["ALARMS", "DETECTOR_COLUMNS", "METRIC_COLUMNS", "truth", "event_metri
 
 DIAGNOSIS = "diagnosis"  # the detector name of a vehicle scenario's [diagnosis]
 # the columns each detector of a scenario gets, as D:<column>
-DETECTOR_COLUMNS = ("detected", "detection_delay_s", "isolated_target", "isolation_delay_s", "identified_value",
-                    "identified_std", "size_error_rel", "size_error_std", "false_alarms", "ambiguous")
+DETECTOR_COLUMNS = ("detected", "detection_delay_s", "isolated_target", "isolated_targets", "isolation_delay_s",
+                    "identified_value", "identified_std", "size_error_rel", "size_error_std", "false_alarms",
+                    "ambiguous", "unexplained", "clear_delay_s")
 # every generic column a run gets, with its type (the run's grid fields and the hook's columns follow)
 METRIC_COLUMNS = {
     "run_id": "string", "case": "string", "draw": "int64", "status": "string", "error": "string",
@@ -39,7 +40,8 @@ METRIC_COLUMNS = {
     "isolated_kind": "string", "isolated_targets": "string",
     "isolation_delay_s": "float64", "identified_value": "float64", "identified_std": "float64",
     "size_error_rel": "float64", "size_error_std": "float64",
-    "false_alarms": "int64", "ambiguous": "bool", "unexcited": "bool", "path_error_rms_m": "float64",
+    "false_alarms": "int64", "ambiguous": "bool", "unexplained": "bool", "unexcited": "bool",
+    "clear_delay_s": "float64", "path_error_rms_m": "float64",
     "duration_s": "float64", "wall_s": "float64",
 }
 
@@ -92,8 +94,10 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
     and the standard deviation the detector stated for it (None where it states none);
     size_error_rel: ``abs(identified - true) / abs(true)`` (None when true is 0); size_error_std: the
     error in stated standard deviations, ``abs(identified - true) / identified_std``; false_alarms: alarms
-    outside the window (module docstring); ambiguous: any such event; unexcited: such an event naming
-    the run's own actuator or sensor (or none: another actuator's idling is not this run's business);
+    outside the window (module docstring); ambiguous, unexplained: any such event; unexcited: such an
+    event naming the run's own actuator or sensor (or none: another actuator's idling is not this run's
+    business); clear_delay_s: for a fault that ends, how long after its end the detector still holds an
+    alarm (:func:`_return_delay`; s, None when the fault lasts the run or an alarm stands to its end);
     events: how many.
     """
     events = sorted(events, key=lambda e: e["t"])
@@ -136,8 +140,30 @@ def event_metrics(true: dict, events: list[dict]) -> dict:
         "size_error_rel": None if value is None or not true_value else abs(value - true_value) / abs(true_value),
         "false_alarms": len({(e.get("detector"), e["t"]) for e in events if e["event"] in ALARMS and not in_window(e)}),
         "ambiguous": any(e["event"] == "ambiguous" for e in events),
+        "unexplained": any(e["event"] == "unexplained" for e in events),
+        "clear_delay_s": _return_delay(events, end),
         "unexcited": any(e["event"] == "unexcited" and e.get("target") in (target, None) for e in events),
     }
+
+
+def _return_delay(events: list[dict], end: float) -> float | None:
+    """Seconds from ``end`` until the events (sorted by time) hold no alarm: 0 when none stands at ``end``
+    (cleared before it, or never raised), None when one stands to the last event (inf: no end). An alarm
+    stands from a "detected" or "isolated" until a "cleared" of its target (none: of every target)."""
+    if math.isinf(end):
+        return None
+    standing: set = set()
+    for e in events:
+        if e["t"] > end and not standing:
+            break
+        if e["event"] in ("detected", "isolated"):
+            standing.add(e.get("target") if e["event"] == "isolated" else "detected")
+        elif e["event"] == "cleared":
+            standing = set() if e.get("target") is None or standing <= {e.get("target"), "detected"} else \
+                standing - {e.get("target")}
+            if e["t"] >= end and not standing:
+                return e["t"] - end
+    return None if standing else 0.0
 
 
 def run_metrics(scenario, result, events: list[dict]) -> dict:
