@@ -81,6 +81,25 @@ def test_each_lane_equals_the_scalar_roll(lanes):
     assert not np.allclose(out[:, :, 0], out[:, :, -1]) or lanes == 1  # the lanes ran apart
 
 
+@pytest.mark.skipif(shutil.which("nm") is None, reason="no nm (binutils) to list the library's symbols")
+def test_erf_runs_in_the_lanes_through_libmvec():
+    """Uniform noise from normal draws goes through erf (the wired loops): its lanes call libmvec's vector
+    erf and equal the scalar roll."""
+    if vector_doubles() < 4:
+        pytest.skip("this processor has no 256-bit vectors")
+    z, w = ca.SX.sym("z", 1), ca.SX.sym("w", 1)
+    step = ca.Function("erf_probe", [z, w], [0.5 * z + ca.erf(w), ca.erf(z * w)])
+    roll = compile_lanes(step, 4)
+    assert "_ZGVdN4v_erf" in _vector_symbols(roll.library)
+    rng = np.random.default_rng(3)
+    W, z0, out = rng.normal(0, 1, (200, 1, 4)), rng.normal(0, 1, (1, 4)), np.empty((200, 1, 4))
+    roll(z0, W, out)
+    for lane in range(4):
+        own = np.empty((200, 1))
+        compile_roll(step)(z0[:, lane].copy(), np.ascontiguousarray(W[:, :, lane]), own)
+        np.testing.assert_allclose(out[:, :, lane], own, rtol=1e-12, atol=1e-15)
+
+
 def test_the_runs_roll_equals_the_lanes_roll_over_each_runs_own_arrays():
     """roll.runs reads each run's own (k, n_w) rows and writes its own (k, n_out) rows: the same numbers as
     the structure-of-arrays roll, a padding lane sharing its run's arrays; mismatched arrays are refused."""

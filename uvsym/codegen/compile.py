@@ -240,11 +240,11 @@ def compile_roll(step: ca.Function, flags: tuple[str, ...] = FAST_FLAGS):
     return _roller(step, library, f"{step.name()}_roll", ())
 
 
-# Math functions with a vector variant in glibc's libmvec (x86-64; 2.22, the rest 2.35): declared
-# SIMD-callable so the lane loop vectorises through them (glibc declares them so only under -ffast-math).
-# A libmvec without one fails the link (-z defs), and the lanes fall back to scalar runs.
+# Math functions with a vector variant in glibc's libmvec (x86-64; sin, cos, exp, log, pow 2.22, the rest
+# 2.35): declared SIMD-callable so the lane loop vectorises through them (glibc declares them so only under
+# -ffast-math). A libmvec without one fails the link (-z defs), and the lanes fall back to scalar runs.
 _VECTOR_MATH = ("sin", "cos", "exp", "log", "pow", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
-                "hypot", "expm1", "log1p", "cbrt")
+                "hypot", "expm1", "log1p", "cbrt", "erf")
 _TWO_ARGUMENTS = {"pow", "atan2", "hypot"}
 _SCALAR_OK = {"sqrt", "fabs", "floor", "ceil", "fmin", "fmax", "copysign", "trunc", "round"}
 _LANE_HELPERS = """#include <math.h>
