@@ -92,7 +92,8 @@ def _two_faults(rows: list[dict], detectors: list[str]) -> list[dict]:
         return row[f"{d}:isolated_targets"] or ("detected, nothing isolated" if row[f"{d}:detected"] else "nothing")
 
     return [{"right_value": r.get("faults[1].value"), "right_onset_s": r.get("faults[1].onset"),
-             "left_value": r["true_value"], "outcomes": {d: outcome(r, d) for d in detectors}} for r in rows]
+             "left": r["true_actuator"], "left_value": r["true_value"], "left_onset_s": r["onset_s"],
+             "outcomes": {d: outcome(r, d) for d in detectors}} for r in rows]
 
 
 def run_study_campaign(out_dir: Path, progress, workers: int | None = 2) -> dict:
@@ -145,8 +146,8 @@ def _returns_section(c: dict) -> str:
     rows = [[f"{run['thruster']} {run['value']:g}"] + [
         ("missed, " if not returns[d]["runs"][i]["detected"] else "")
         + _return_cell(returns[d]["runs"][i]["return_s"]) for d in detectors] for i, run in enumerate(first)]
-    both = [[f"T_L 0.5, T_R {t['right_value']:g} from {t['right_onset_s']:g} s"] + [t["outcomes"][d] for d in detectors]
-            for t in two]
+    both = [[f"{t['left']} {t['left_value']:g} from {t['left_onset_s']:g} s, the other {t['right_value']:g} from "
+             f"{t['right_onset_s']:g} s"] + [t["outcomes"][d] for d in detectors] for t in two]
 
     def verdicts(d: str) -> list[str]:
         r = returns[d]

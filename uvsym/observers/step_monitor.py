@@ -88,10 +88,10 @@ def _beyond(trend: np.ndarray, column: np.ndarray) -> np.ndarray:
 
 def step_models(before: int, after: int, glitch: int) -> dict:
     """The window's models (module docstring) for ``before`` + ``after`` samples: ``step`` (W, r)
-    basis, ``healthy`` list of bases; the same as the statistic uses them: ``trend`` (W, 3) the
-    trend's orthonormal basis, ``step_beyond`` (W, 2) and ``healthy_beyond`` (W, n_h) orthonormal
-    columns of each model past the trend (a healthy model adds one column, so its RSS is the trend's
-    less one squared product: ``g sigma^2 = |S^T v|^2 - max_k (c_k^T v)^2``, S = step_beyond);
+    basis, ``healthy`` list of bases; the same as the statistic uses them: ``step_beyond`` (W, 2) and
+    ``healthy_beyond`` (W, n_h) orthonormal columns of each model past the quadratic trend (a healthy
+    model adds one column, so its RSS is the trend's less one squared product:
+    ``g sigma^2 = |S^T v|^2 - max_k (c_k^T v)^2``, S = step_beyond);
     ``estimators`` (after, W) rows: the step size from the last ``B + a`` samples (a = 1..A;
     zero-padded in front), ``step_std`` (after,) their standard deviation per unit sigma, ``joint``
     (after, W): row a2 the size of the step at B fitted together with a second step a2 samples ago
@@ -111,7 +111,7 @@ def step_models(before: int, after: int, glitch: int) -> dict:
     healthy = [trend_basis] + [_basis(trend(W) + [column]) for column in extras]
     jump, ramp = (i >= before).astype(float), np.where(i >= before, i - before + 1.0, 0.0)
     step = _basis(trend(W) + [jump, ramp])
-    step_beyond = _basis([jump - trend_basis @ (trend_basis.T @ jump), ramp - trend_basis @ (trend_basis.T @ ramp)])
+    step_beyond = _basis([_beyond(trend_basis, jump), _beyond(trend_basis, ramp)])
     healthy_beyond = np.column_stack([_beyond(trend_basis, column) for column in extras])
     estimators, step_std = np.zeros((after, W)), np.zeros(after)
     for a in range(1, after + 1):  # the step a samples ago, from the last B + a samples
@@ -125,8 +125,8 @@ def step_models(before: int, after: int, glitch: int) -> dict:
     for a2 in range(1, after):
         X = np.column_stack(trend(W) + [jump, (i >= W - a2).astype(float)])
         joint[a2] = np.linalg.pinv(X)[_TREND_ORDER + 1]
-    return {"step": step, "healthy": healthy, "trend": trend_basis, "step_beyond": step_beyond,
-            "healthy_beyond": healthy_beyond, "estimators": estimators, "step_std": step_std, "joint": joint}
+    return {"step": step, "healthy": healthy, "step_beyond": step_beyond, "healthy_beyond": healthy_beyond,
+            "estimators": estimators, "step_std": step_std, "joint": joint}
 
 
 def sensor_step_monitor(measured: Signals, *, noise_std: float, dt: float, false_alarms_per_hour: float = 0.1,
