@@ -106,6 +106,10 @@ def test_power_rises_with_the_step_and_the_window_and_stays_off_healthy_records(
     assert step_power([1e-9], dt=0.2, edges=60)["probability"] == [0.0]
     with pytest.raises(ObserverError, match="size"):
         step_power([-1.0], dt=0.2)
+    with pytest.raises(ObserverError, match="edges"):
+        step_power([5.0], dt=0.2, edges=0)
+    with pytest.raises(ObserverError, match="sequence"):
+        step_power("5", dt=0.2)
 
 
 def test_a_turn_is_not_a_step_and_a_long_healthy_record_confirms_nothing():

@@ -238,7 +238,10 @@ def step_power(sizes, *, dt: float, false_alarms_per_hour: float = 0.1, before: 
 
     Returns ``{"sizes": [...], "probability": [...], "edges": edges}`` (probabilities in [0, 1]).
     """
+    if isinstance(sizes, (str, bytes)) or not hasattr(sizes, "__iter__"):
+        raise ObserverError(f"step_power: sizes must be a sequence of step sizes (noise std), got {sizes!r}")
     sizes = [real(size, "step_power: size", ObserverError, positive=True) for size in sizes]
+    edges = integer(edges, "step_power: edges", ObserverError, minimum=1)
     monitor = sensor_step_monitor(signals(("y", "-", "measured")), noise_std=1.0, dt=dt,
                                   false_alarms_per_hour=false_alarms_per_hour, before=before, after=after,
                                   glitch=glitch, alarm_z=alarm_z)
