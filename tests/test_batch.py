@@ -15,7 +15,7 @@ from uvsym.codegen.compile import find_compiler
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, Profile, apply_actuator_faults
 from uvsym.sim.batch import simulate_batch
-from uvsym.sim.closed_loop import actuator_fault_columns, build_closed_loop
+from uvsym.sim.closed_loop import actuator_fault_table, build_closed_loop
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import observer_blocks, simulate_scenario
 from uvsym.sim.system_scenario import parse_system_scenario, simulate_system_scenario
@@ -88,8 +88,11 @@ def test_fault_columns_compose_faults_in_order_as_worked_by_hand(scenarios):
                              observers=observer_blocks(model, scenarios[0].observers, dt))
     faults = (ActuatorFault(1, "proportional", 0.5, Profile("ramp", onset=0.0, duration=1.0)),
               ActuatorFault(1, "bias", 2.0, Profile("step", onset=0.5)))
-    columns = actuator_fault_columns(loop, faults, 4)  # samples at 0, 0.25, ..., 1 s; stages at +0, +dt/2, +dt
+    touched, values = actuator_fault_table(loop, faults, 4)  # samples at 0, 0.25, ..., 1 s; stages +0, +dt/2, +dt
     m, stages = model.n_inputs, 3
+    columns = np.zeros((5, 2 * stages * m))
+    columns[:, touched] = values
+    assert touched.tolist() == [1, m + 1, 2 * m + 1, 3 * m + 1, 4 * m + 1, 5 * m + 1]  # actuator 1's D and B only
     D = columns[:, :m * stages].reshape(5, stages, m)[:, :, 1]
     B = columns[:, m * stages:].reshape(5, stages, m)[:, :, 1]
     # v -> v + phi (0.5 v - v) = (1 - phi / 2) v with phi = min(t, 1), then + 2 from t = 0.5 s

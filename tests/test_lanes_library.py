@@ -17,6 +17,7 @@ import pytest
 from uvsym.codegen.compile import compile_lanes, compile_roll, find_compiler, vector_doubles
 from uvsym.errors import CodegenError
 from uvsym.sim.batch import LANES, default_lanes
+from uvsym.sim.inputs import compact
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
 
@@ -119,6 +120,25 @@ def test_the_runs_roll_equals_the_lanes_roll_over_each_runs_own_arrays():
         roll.runs(z_end, Ws + [Ws[0][:, :1]], outs + outs[-1:])
     with pytest.raises(CodegenError, match="of one k"):
         roll.runs(z_end, Ws + Ws[-1:], outs[:2] + [outs[2][:-1], outs[2][:-1]])
+
+
+def test_the_runs_roll_reads_compact_inputs_as_their_dense_tables():
+    """Lanes whose W holds one column still (a constant), one varying, or every column varying read the same
+    numbers as from the dense tables, bitwise; mixed in one call."""
+    step, N, lanes = _step(), 250, 4
+    rng = np.random.default_rng(11)
+    z0 = rng.uniform(-1.0, 1.0, (2, lanes))
+    dense = [np.ascontiguousarray(rng.uniform(-2.0, 2.0, (N, 2))) for _ in range(lanes)]
+    dense[0][:, 1], dense[1][:, 0], dense[2][:] = 0.7, -1.3, [0.4, 0.2]  # w1 still; w0 still; both still
+    given = [compact(W) for W in dense[:3]] + dense[3:]
+    assert [W.columns.tolist() for W in given[:3]] == [[0], [1], []]
+    compacted, plain = [np.empty((N, 2)) for _ in range(lanes)], [np.empty((N, 2)) for _ in range(lanes)]
+    roll = compile_lanes(step, lanes)
+    np.testing.assert_array_equal(roll.runs(z0, given, compacted), roll.runs(z0, dense, plain))
+    for mine, theirs in zip(compacted, plain):
+        np.testing.assert_array_equal(mine, theirs)
+    with pytest.raises(CodegenError, match="compact inputs"):
+        roll.runs(z0, [given[0][:-1]] + given[1:], compacted)  # one lane a sample short
 
 
 @pytest.mark.skipif(shutil.which("objdump") is None, reason="no objdump (binutils) to read the library's code")

@@ -168,27 +168,36 @@ def _roller(step: ca.Function, library: Path, symbol: str, lanes: tuple[int, ...
 def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
     """runs(z0, Ws, outs) -> z_end calling ``symbol`` of ``library``: the lanes over each run's own arrays."""
     n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
-    pointers = ctypes.c_void_p * lanes
+    pointers, counts = ctypes.c_void_p * lanes, ctypes.c_long * lanes
     function = getattr(ctypes.CDLL(str(library)), symbol)
-    function.argtypes = [_POINTER, pointers, _POINTER, pointers, ctypes.c_long]
+    function.argtypes = [_POINTER, pointers, pointers, counts, pointers, _POINTER, pointers, ctypes.c_long]
+    every_column, unused = np.arange(n_w, dtype=np.int_), np.zeros(n_w)  # a dense W: every column varies
 
-    def runs(z0: np.ndarray, Ws: list[np.ndarray], outs: list[np.ndarray]) -> np.ndarray:
-        """k steps of every lane: lane l reads the rows of Ws[l] (k, n_w) and writes outs[l] (k, n_out)
-        (C-contiguous float64 arrays; lanes may share an array, a padding lane its run's); z0, z_end (n_z, L)."""
+    def runs(z0: np.ndarray, Ws: list, outs: list[np.ndarray]) -> np.ndarray:
+        """k steps of every lane: lane l reads the rows of Ws[l] (k, n_w: a C-contiguous float64 array, or
+        compact inputs with ``constant`` (n_w,), ``columns`` (n_var,) and ``rows`` (k, n_var) as
+        :class:`~uvsym.sim.inputs.CompactInputs` holds them) and writes outs[l] (k, n_out) (lanes may share
+        an array, a padding lane its run's); z0, z_end (n_z, L)."""
         z0 = np.ascontiguousarray(z0, dtype=float)
         k = Ws[0].shape[0] if len(Ws) else 0
+        parts = [(unused, every_column, W) if isinstance(W, np.ndarray) else (W.constant, W.columns, W.rows)
+                 for W in Ws]
 
-        def fit(arrays, width: int, writes: bool) -> bool:
-            return len(arrays) == lanes and all(
-                a.shape == (k, width) and a.dtype == np.float64 and a.flags.c_contiguous
-                and (a.flags.writeable or not writes) for a in arrays)
+        def fit(a, width: int, writes: bool) -> bool:
+            return (a.shape == (k, width) and a.dtype == np.float64 and a.flags.c_contiguous
+                    and (a.flags.writeable or not writes))
 
-        if z0.shape != (n_z, lanes) or not (fit(Ws, n_w, False) and fit(outs, n_out, True)):
+        if z0.shape != (n_z, lanes) or len(Ws) != lanes or len(outs) != lanes or not (
+                all(fit(rows, columns.size, False) and constant.shape == (n_w,) and constant.dtype == np.float64
+                    and columns.dtype == np.int_ and columns.flags.c_contiguous for constant, columns, rows in parts)
+                and all(fit(out, n_out, True) for out in outs)):
             raise CodegenError(f"the lanes' runs need z0 ({n_z}, {lanes}) and {lanes} C-contiguous float64 W (k, "
-                               f"{n_w}) and out (k, {n_out}) of one k")
+                               f"{n_w}) (or compact inputs of that shape) and out (k, {n_out}) of one k")
         z_end = np.empty_like(z0)
-        if function(z0.ctypes.data_as(_POINTER), pointers(*(W.ctypes.data for W in Ws)),
-                    z_end.ctypes.data_as(_POINTER), pointers(*(out.ctypes.data for out in outs)), k):
+        if function(z0.ctypes.data_as(_POINTER), pointers(*(c.ctypes.data for c, _, _ in parts)),
+                    pointers(*(j.ctypes.data for _, j, _ in parts)), counts(*(j.size for _, j, _ in parts)),
+                    pointers(*(r.ctypes.data for _, _, r in parts)), z_end.ctypes.data_as(_POINTER),
+                    pointers(*(out.ctypes.data for out in outs)), k):
             raise CodegenError(f"{step.name()} failed inside the compiled loop")
         return z_end
 
@@ -275,22 +284,25 @@ int {name}_lanes_roll(const double* z0, const double* W, double* z_end, double* 
   memcpy(z_end, z, sizeof a);
   return 0;
 }}
-/* the same roll over each lane's own row-major arrays W_l (N, n_w) and O_l (N, n_out), gathered into and
-   scattered from the structure of arrays one step at a time (in the cache: no pass over the runs' memory) */
-int {name}_lanes_runs(const double* z0, const double* const* W, double* z_end, double* const* O, long N) {{
+/* the same roll over each lane's own row-major arrays, gathered into and scattered from the structure of
+   arrays one step at a time (in the cache: no pass over the runs' memory). Lane l's inputs: the constant
+   row C_l (n_w) and the nJ_l columns J_l that vary, their rows W_l (N, nJ_l); its outputs O_l (N, n_out). */
+int {name}_lanes_runs(const double* z0, const double* const* C, const long* const* J, const long* nJ,
+                      const double* const* W, double* z_end, double* const* O, long N) {{
   double a[{n_z} * {L}], b[{n_z} * {L}], w[{n_w} * {L}], o[{n_out} * {L}];
   double *z = a, *zn = b, *swap;
-  const double* Wl[{L}];
-  double* Ol[{L}];
-  memcpy(Wl, W, sizeof Wl);
-  memcpy(Ol, O, sizeof Ol);
+  for (long l = 0; l < {L}; ++l)
+    for (long j = 0; j < {n_w}; ++j) w[j * {L} + l] = C[l][j];
   memcpy(z, z0, sizeof a);
   for (long k = 0; k < N; ++k) {{
-    for (long l = 0; l < {L}; ++l)
-      for (long j = 0; j < {n_w}; ++j) w[j * {L} + l] = Wl[l][k * {n_w} + j];
+    for (long l = 0; l < {L}; ++l) {{
+      const long n = nJ[l], *Jl = J[l];
+      const double* row = W[l] + k * n;
+      for (long i = 0; i < n; ++i) w[Jl[i] * {L} + l] = row[i];
+    }}
     {name}_lanes_step(z, w, zn, o);
     for (long l = 0; l < {L}; ++l)
-      for (long j = 0; j < {n_out}; ++j) Ol[l][k * {n_out} + j] = o[j * {L} + l];
+      for (long j = 0; j < {n_out}; ++j) O[l][k * {n_out} + j] = o[j * {L} + l];
     swap = z; z = zn; zn = swap;
   }}
   memcpy(z_end, z, sizeof a);
@@ -330,7 +342,8 @@ def compile_lanes(step: ca.Function, lanes: int, flags: tuple[str, ...] = FAST_F
     Returns ``roll(z0 (n_z, L), W (k, n_w, L), out (k, n_out, L)) -> z_end (n_z, L)``: k steps of every
     lane, lane l reading ``W[:, :, l]`` (C-contiguous float64 arrays, structure of arrays); and
     ``roll.runs(z0, Ws, outs) -> z_end``, the same over L runs' own arrays ``Ws[l]`` (k, n_w) and
-    ``outs[l]`` (k, n_out), as the scalar roll takes them (no stacking or transposing of whole runs).
+    ``outs[l]`` (k, n_out), as the scalar roll takes them (no stacking or transposing of whole runs);
+    a run's W may be compact (its varying columns and one constant row), read n_var columns per step.
     Memoized in-process as :func:`compile_roll` is.
 
     Raises CodegenError when there is no compiler, the step is not straight-line scalar code, or

@@ -33,6 +33,7 @@ from uvsym.codegen.cache import frozen, memoized
 from uvsym.codegen.compile import compile_lanes, vector_doubles
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
+from uvsym.sim.inputs import CompactInputs, input_rows
 from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.run import CHUNK, check_chunk, run_closed_loop
 from uvsym.sim.scenario import Scenario
@@ -107,7 +108,7 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
                                  current=_shared_current([scenarios[i] for i in members]) if current_in_step
                                  else None)
         runs = [prepare_run(scenarios[i].model, scenarios[i].controller, **scenario_arguments(scenarios[i], observers),
-                            substeps=substeps, loop=loop) for i in members]
+                            substeps=substeps, loop=loop, compact=True) for i in members]
         names = [scenarios[i].name for i in members]
         for i, result in zip(members, run_lanes(runs, lanes=lanes, compiled=compiled, names=names)):
             meta = {"scenario": scenarios[i].name, **result.meta}
@@ -135,7 +136,7 @@ def _system_lanes(scenarios: list, lanes: int | None, compiled: bool) -> list[Si
     from uvsym.sim.system_scenario import decided, scenario_inputs, scenario_meta_arguments
     from uvsym.sim.system_simulation import wired_meta
 
-    runs = [PreparedRun(scenario.loop, scenario.z0, scenario_inputs(scenario), None,
+    runs = [PreparedRun(scenario.loop, scenario.z0, scenario_inputs(scenario, compact=True), None,
                         wired_meta(scenario.loop, method="fast", **scenario_meta_arguments(scenario)),
                         scenario.rk4_tolerance) for scenario in scenarios]
     results = run_lanes(runs, lanes=lanes, compiled=compiled, names=[s.name for s in scenarios])
@@ -185,7 +186,8 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         group = list(runs[first:first + lanes])
         started = time.perf_counter()
         # each run's own W and logged rows, as the scalar path has them: the roll gathers and scatters the lanes
-        Ws = [np.ascontiguousarray(run.W, dtype=float) for run in group]
+        Ws = [run.W if isinstance(run.W, CompactInputs) else np.ascontiguousarray(run.W, dtype=float)
+              for run in group]
         outputs = [np.empty((N + 1, n_out)) for _ in group]
         padding = lanes - len(group)  # padding lanes repeat the last run, into its own rows (the same values)
         lane_W, lane_out = Ws + Ws[-1:] * padding, outputs + outputs[-1:] * padding
@@ -197,25 +199,30 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
                 W_rows, rows = W[start:start + k], out[start:start + k]
                 try:
                     if not (np.isfinite(rows).all() and np.isfinite(z[:, lane]).all()):
-                        check_chunk(loop, "fast", start, W_rows, rows, z[:, lane], run.guard)
+                        check_chunk(loop, "fast", start, input_rows(W_rows, slice(None)), rows, z[:, lane], run.guard)
                     elif run.guard is not None:
-                        run.guard(W_rows[:, 0], rows)
+                        run.guard(_times(W_rows), rows)
                 except SimulationError as exc:
                     raise SimulationError(f"run {names[first + lane]}: {exc}") from None
-        last = np.asarray(_final(loop.discrete, lanes)(z, np.stack([W[N] for W in lane_W], axis=-1))[2])
+        last = np.asarray(_final(loop.discrete, lanes)(z, np.stack([input_rows(W, N) for W in lane_W], axis=-1))[2])
         for lane, out in enumerate(outputs):
             out[N] = last[:, lane]
         wall = time.perf_counter() - started
         checked = [(lane, (out, W, run.rk4_tolerance)) for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))
                    if run.rk4_tolerance is not None]  # as the scalar path checks them, all in one call
-        errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked])))
+        errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked], compiled=True)))
         for lane, (run, W, out) in enumerate(zip(group, Ws, outputs)):  # views of the run's rows: no copy
             signals = {name: Signal(out[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
             meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}
             if errors.get(lane) is not None:
                 meta["rk4_error"] = errors[lane]
-            results.append(SimResult(W[:, 0].copy(), signals, meta))
+            results.append(SimResult(_times(W).copy(), signals, meta))
     return results
+
+
+def _times(W) -> np.ndarray:
+    """(k,) the sample times (s), column 0 of a run's W (dense or compact)."""
+    return W.column(0) if isinstance(W, CompactInputs) else W[:, 0]
 
 
 @memoized(16)
@@ -226,6 +233,7 @@ def _final(discrete, lanes: int):
 
 def _scalar(run: PreparedRun, compiled: bool) -> SimResult:
     """One run on the scalar fast path (the fallback of :func:`run_lanes`)."""
-    result, timing = run_closed_loop(run.loop, run.z0, run.W.copy(), compiled=compiled, guard=run.guard,
+    W = input_rows(run.W, slice(None)).copy()  # the runner writes a supervisor's decisions into its W
+    result, timing = run_closed_loop(run.loop, run.z0, W, compiled=compiled, guard=run.guard,
                                      rk4_tolerance=run.rk4_tolerance)
     return SimResult(result.t, result.signals, {**run.meta, **timing})

@@ -10,7 +10,7 @@ actuator faults at the J = 2 substeps + 1 distinct RK4 stage times of the sample
 Every actuator fault kind is affine in the value v it acts on (``ActuatorKind.affine``), and so is
 its blend ``v + phi (deliver(v) - v)`` with the profile phi(t), and a chain of them: the fixed-step
 path applies ``a + D_j a + B_j`` (D_j = 0, B_j = 0 healthy), with (D_j, B_j) worked out in numpy
-from the fault list (:func:`actuator_fault_columns`). One compiled step thus serves every actuator
+from the fault list (:func:`actuator_fault_table`). One compiled step thus serves every actuator
 fault of a loop, and lanes of a batch can differ in them. The integrators' ``plant_ode`` keeps the
 faults symbolic in continuous time.
 
@@ -40,7 +40,7 @@ from uvsym.sim.controllers import Autopilot
 from uvsym.sim.loop import SampledLoop, logged_signals
 from uvsym.symbolic import rk4
 
-__all__ = ["ClosedLoop", "build_closed_loop", "actuator_fault_columns"]
+__all__ = ["ClosedLoop", "build_closed_loop", "actuator_fault_table"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -49,7 +49,7 @@ class ClosedLoop(SampledLoop):
     :class:`~uvsym.sim.loop.SampledLoop`). ``layout`` maps x, a, xc, xo, a_expected, held to
     their slices; ``observers`` the estimators by name, ``observer_slices`` their states within
     xo. ``env_columns``, ``correction_columns``, ``fault_columns``: where w holds (V_c, beta_c),
-    (vec(S), o) and the actuator faults (D, B), filled by :func:`actuator_fault_columns`.
+    (vec(S), o) and the actuator faults (D, B), filled by :func:`actuator_fault_table`.
     """
 
     model: Model
@@ -179,26 +179,40 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
                       correction_columns=slice(3 + n, 3 + n + m * m + m), fault_columns=slice(3 + n + m * m + m, n_w))
 
 
-def actuator_fault_columns(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], N: int) -> np.ndarray:
-    """w's fault columns (N + 1, 2 m J) for ``faults`` at the sample times k dt, k = 0..N: per stage j the
-    (D_j, B_j) with ``applied = a + D_j a + B_j`` at ``k dt + j dt / (2 substeps)``, faults composed in order.
+def actuator_fault_table(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], N: int) -> tuple[np.ndarray, np.ndarray]:
+    """(columns (n,), values (N + 1, n)): the fault columns (within w's fault block, ascending) that ``faults``
+    can make non-zero and their values; the block is ``[D_0 .. D_J-1, B_0 .. B_J-1]``, each (m,), actuator a of
+    stage j at ``j m + a``: per stage j the (D_j, B_j) with ``applied = a + D_j a + B_j`` at the stage time
+    ``k dt + j dt / (2 substeps)`` of sample k = 0..N, faults composed in order (every other column 0).
 
     A fault ``v -> v + phi (g v + b - v)`` (``(g, b) = kind.affine(value)``) maps ``(D, B)`` to
     ``(D + c + c D, B + c B + phi b)`` with ``c = phi (g - 1)``.
     """
     m, stages = loop.model.n_inputs, 2 * loop.substeps + 1
-    columns = np.zeros((N + 1, 2 * stages * m))  # [D_0 .. D_J-1, B_0 .. B_J-1], each (m,): actuator a at j m + a
-    folded: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # actuator -> its (D, B) (N + 1, J), faults in order
+    affine = []
     for fault in faults:
         _check_index(fault.actuator, m, "actuator")
-        gain, shift = fault.kind_object.affine(fault.value)
+        affine.append((fault.actuator, *fault.kind_object.affine(fault.value)))
+    # the columns a fault can make non-zero: an actuator's D where one of its gains is not 1, its B where one
+    # of its shifts is not 0 (a gain only scales a B some shift made), each over its stages
+    parts = sorted({(part, actuator) for actuator, gain, shift in affine
+                    for part, acts in ((0, gain != 1.0), (1, shift != 0.0)) if acts})
+    where = {part: i for i, part in enumerate(parts)}
+    # one buffer (parts, N + 1, J) composed in place, faults in order: temporaries of a run's length cost
+    # their page faults on every call
+    folded, c, scratch = np.zeros((len(parts), N + 1, stages)), np.empty((N + 1, stages)), np.empty((N + 1, stages))
+    for fault, (actuator, gain, shift) in zip(faults, affine):
         phi = _stage_phi(fault.profile, loop.dt, loop.substeps, N)
-        c = phi * (gain - 1.0)
-        d, b = folded.get(fault.actuator, (0.0, 0.0))
-        folded[fault.actuator] = d + c + c * d, b + c * b + phi * shift
-    for actuator, (d, b) in folded.items():
-        columns[:, actuator:stages * m:m], columns[:, stages * m + actuator::m] = d, b
-    return columns
+        np.multiply(phi, gain - 1.0, out=c)
+        for part in (0, 1):
+            if (part, actuator) in where:  # D + c + c D, B + c B + phi b
+                value = folded[where[part, actuator]]
+                value += np.multiply(c, value, out=scratch)
+                value += c if part == 0 else np.multiply(phi, shift, out=scratch)
+    columns = [part * stages * m + j * m + actuator for part, actuator in parts for j in range(stages)]
+    order = np.argsort(columns, kind="stable")
+    table = np.ascontiguousarray(folded.transpose(1, 0, 2).reshape(N + 1, -1)[:, order])
+    return np.asarray(columns, dtype=np.int_)[order], table
 
 
 @functools.lru_cache(maxsize=32)

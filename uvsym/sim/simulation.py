@@ -17,8 +17,9 @@ from uvsym.observers import ActuatorObserver, actuator_observer
 from uvsym.observers.base import Observer
 from uvsym.observers.discrete import actuator_fault_observer
 from uvsym.observers.gains import design_gains
-from uvsym.sim.closed_loop import ClosedLoop, actuator_fault_columns, build_closed_loop
+from uvsym.sim.closed_loop import ClosedLoop, actuator_fault_table, build_closed_loop
 from uvsym.sim.controllers import Autopilot
+from uvsym.sim.inputs import CompactInputs, input_rows
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
@@ -32,12 +33,12 @@ __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observe
 @dataclass(frozen=True)
 class PreparedRun:
     """A run of :func:`simulate` ready for the runner: its loop, initial state z0 (n_z,), per-sample
-    inputs W (N + 1, n_w), the attitude guard (None below 6 DOF), the result's meta (no timings) and
-    the fast path's step-error tolerance (None: not checked)."""
+    inputs W (N + 1, n_w; dense, or compact for the lanes), the attitude guard (None below 6 DOF), the
+    result's meta (no timings) and the fast path's step-error tolerance (None: not checked)."""
 
     loop: ClosedLoop
     z0: np.ndarray
-    W: np.ndarray
+    W: np.ndarray | CompactInputs
     guard: Callable | None
     meta: dict
     rk4_tolerance: float | None = TOLERANCE
@@ -117,13 +118,14 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
                 current=(0.0, 0.0), actuator_faults: tuple[ActuatorFault, ...] = (),
                 sensor_faults: tuple[SensorFault, ...] = (), observers: tuple[Observer, ...] = (),
                 method: str = "fast", substeps: int = 1, seed: int = 0, current_in_w: bool = False,
-                loop: ClosedLoop | None = None) -> PreparedRun:
+                loop: ClosedLoop | None = None, compact: bool = False) -> PreparedRun:
     """The loop, z0, W, guard and meta of :func:`simulate` (same arguments), checked, before anything runs.
 
     current_in_w: read a constant current from W rather than build it into the step (so runs with
     different currents share one compiled step, as the lanes of a batch do). loop: one already built
     for this model, controller, dt, sensor faults, observers and substeps with ``current=None``, to
     share (its fixed-step ``step`` takes the actuator faults from W; its ``plant_ode`` is not used).
+    compact: W as :class:`~uvsym.sim.inputs.CompactInputs` (what the lanes read), else dense.
     """
     N = grid(duration, dt)
     env = np.asarray(current, dtype=float)
@@ -140,16 +142,13 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
                                  sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
                                  current=tuple(env) if env.shape == (2,) and not current_in_w else None)
     check_memory(memory_needed(N + 1, loop), f"{duration:g} s at step {dt:g} s ({N + 1} samples)")
-    # one row per sample: [t, noise, V_c, beta_c, vec(S), o, D, B]; no draws where no sensor fault reads them
-    W = sample_inputs(loop.n_w, N, dt, n if sensor_faults else 0, seed)
-    W[:, loop.env_columns] = env.reshape(-1, 2)
-    W[:, loop.correction_columns] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
-    W[:, loop.fault_columns] = actuator_fault_columns(loop, tuple(actuator_faults), N)
+    inputs = _run_inputs(loop, N, dt, env, tuple(actuator_faults), n if sensor_faults else 0, seed)
+    W = inputs if compact else inputs.dense()
 
     lay = loop.layout
     z0 = np.zeros(loop.n_z)
     z0[lay["x"]], z0[lay["held"]] = x0, x0
-    _, u_cmd0, _ = loop.discrete(z0, W[0])
+    _, u_cmd0, _ = loop.discrete(z0, input_rows(W, 0))
     a0 = np.asarray(u_cmd0).ravel() if actuators0 is None else _vector(actuators0, m, "actuators0")
     z0[lay["a"]], z0[lay["a_expected"]] = a0, a0
     tau_d0 = np.asarray(model.tau(x0[:dof], x0[dof:], a0, 0.0, 0.0)).ravel()
@@ -165,6 +164,29 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
             "actuator_faults": [fault_summary(f, model.input_labels[f.actuator]) for f in actuator_faults],
             "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults]}
     return PreparedRun(loop, z0, W, _attitude_guard(loop) if dof == 6 else None, meta)
+
+
+def _run_inputs(loop: ClosedLoop, N: int, dt: float, env: np.ndarray, faults: tuple[ActuatorFault, ...], n_noise: int,
+                seed: int) -> CompactInputs:
+    """The run's W (N + 1, n_w) at samples k dt, ``[t, noise, V_c, beta_c, vec(S), o, D, B]``, as its varying
+    columns: the times, ``n_noise`` seeded draws behind sensor faults, the current where it varies and the
+    fault columns the faults touch; the rest constant (the current where it holds, the correction S = I,
+    o = 0, no fault)."""
+    m = loop.model.n_inputs
+    constant = np.zeros(loop.n_w)
+    constant[loop.correction_columns] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
+    blocks = [sample_inputs(1 + n_noise, N, dt, n_noise, seed)]  # t, noise: columns 0..n_noise
+    columns = [np.arange(1 + n_noise)]
+    env_columns = np.arange(loop.n_w)[loop.env_columns]
+    if env.shape == (2,):
+        constant[env_columns] = env
+    else:
+        blocks.append(env)
+        columns.append(env_columns)
+    touched, values = actuator_fault_table(loop, faults, N)
+    blocks.append(values)
+    columns.append(loop.fault_columns.start + touched)
+    return CompactInputs(constant, np.concatenate(columns).astype(np.int_), np.ascontiguousarray(np.hstack(blocks)))
 
 
 def _attitude_guard(loop):

@@ -24,13 +24,16 @@ import casadi as ca
 import numpy as np
 
 from uvsym.codegen.cache import memoized
-from uvsym.errors import IntegrationAccuracyWarning, SimulationError
+from uvsym.codegen.compile import DEFAULT_FLAGS, compile_function
+from uvsym.errors import CodegenError, IntegrationAccuracyWarning, SimulationError
+from uvsym.sim.inputs import input_rows
 from uvsym.symbolic import rk4
 
-__all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance", "checked_runs", "checked_steps",
-           "state_name", "step_error", "step_errors"]
+__all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance",
+           "checked_runs", "checked_steps", "state_name", "step_error", "step_errors"]
 
 CHECKS, EARLY, JUMPS = 32, 4, 12
+_ROWS = 1024  # logged rows read back at a time by a run's check
 TOLERANCE = 1e-4  # default: local error per sample, relative to each state entry's scale over the run
 ATOL = 1e-12  # absolute floor of every entry's scale (its unit)
 
@@ -107,21 +110,32 @@ def _doubled(plant_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
 
 
 @memoized(16)
-def _mapped(doubled: ca.Function, runs: int) -> ca.Function:
-    """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column."""
-    return doubled.map(CHECKS * runs)
+def _mapped(doubled: ca.Function, runs: int, compiled: bool) -> ca.Function:
+    """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column; compiled: its C
+    (from the compile cache; CasADi's virtual machine where there is no compiler)."""
+    return (_compiled(doubled) if compiled else doubled).map(CHECKS * runs)
+
+
+@memoized(16)
+def _compiled(doubled: ca.Function) -> ca.Function:
+    """``doubled`` compiled (about 6x faster than CasADi's virtual machine on the docking vehicle; no fused
+    multiply-adds, so that it rounds as the virtual machine does), or itself where it cannot be."""
+    try:
+        return compile_function(doubled, (*DEFAULT_FLAGS, "-ffp-contract=off"))
+    except CodegenError:
+        return doubled
 
 
 def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> StepError | None:
     """The largest error of the checked steps of a finished run (module docstring): outputs (N + 1, n_out)
-    its logged rows, W (N + 1, n_w) its inputs. None for a discrete-time plant, a loop that cannot read its
-    integrated state back, or a run of no step."""
+    its logged rows, W (N + 1, n_w) its inputs (dense or compact). None for a discrete-time plant, a loop
+    that cannot read its integrated state back, or a run of no step."""
     return step_errors(loop, [(outputs, W, tolerance)])[0]
 
 
-def step_errors(loop, runs) -> list[StepError | None]:
+def step_errors(loop, runs, compiled: bool = False) -> list[StepError | None]:
     """:func:`step_error` of each run ``(outputs, W, tolerance)`` of one loop, every checked step of every run
-    in one call of the doubled step mapped over them all."""
+    in one call of the doubled step mapped over them all (compiled: its C, as compiled loops want)."""
     if loop.plant_ode is None:
         return [None] * len(runs)
     plans = [_plan(loop, outputs, W, tolerance) for outputs, W, tolerance in runs]
@@ -129,16 +143,17 @@ def step_errors(loop, runs) -> list[StepError | None]:
     if checked:  # the rows of each run's checked steps (its last one repeated to fill CHECKS columns)
         rows = [ks + ks[-1:] * (CHECKS - len(ks)) for *_, ks in checked]
         arguments = [np.concatenate(parts, axis=1) for parts in zip(*(
-            (S[r].T, U[r].T, W[r][:, loop.env_columns].T, W[r, 0][None, :])
-            for (_, S, U, W, _), r in zip(checked, rows)))]
+            (S_r.T, U_r.T, W_r[:, loop.env_columns].T, W_r[:, 0][None, :])
+            for (_, outputs, W, _), r in zip(checked, rows)
+            for (S_r, U_r), W_r in [(loop.integrated(outputs[r]), input_rows(W, r))]))]
         doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
-        coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(checked))(*arguments))
+        coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(checked), compiled)(*arguments))
     errors, i = [], 0
     for plan in plans:
         if plan is None:
             errors.append(None)
             continue
-        scale, _, _, W, ks = plan
+        scale, _, W, ks = plan
         worst = (0.0, 0.0, 0)
         if ks:
             block = slice(i * CHECKS, i * CHECKS + len(ks))
@@ -149,24 +164,29 @@ def step_errors(loop, runs) -> list[StepError | None]:
             valid = np.flatnonzero(np.isfinite(largest) & (largest > 0))  # a step with a non-finite entry says nothing
             if valid.size:
                 j = int(valid[np.argmax(largest[valid])])
-                worst = (float(largest[j]), float(W[ks[j], 0]), int(entries[j]))
+                worst = (float(largest[j]), float(input_rows(W, ks[j])[0]), int(entries[j]))
         ratio, t_s, entry = worst
         needed = loop.substeps if ratio <= 1.0 else math.ceil(loop.substeps * ratio ** 0.25)
         errors.append(StepError(ratio, t_s, entry, needed, len(ks)))
     return errors
 
 
-def _plan(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float):
-    """(scale, S, U, W, checked samples) of a run's step check, or None where nothing can be checked."""
-    if len(W) < 2:
+def _plan(loop, outputs: np.ndarray, W, tolerance: float):
+    """(scale, outputs, W, checked samples) of a run's step check, or None where nothing can be checked. The
+    logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small)."""
+    if len(W) < 2 or loop.integrated(outputs[:1]) is None:
         return None
-    read = loop.integrated(outputs)
-    if read is None:
-        return None
-    S, U = read
-    faulty = np.ascontiguousarray(loop.logged(outputs, "fault_actuator").T) != 0  # (m, N + 1)
+    largest, inputs, faults = [], [], []
+    for start in range(0, len(outputs), _ROWS):
+        rows = outputs[start:start + _ROWS]
+        S, U = loop.integrated(rows)
+        largest.append(_column_max(S))
+        inputs.append(U.T)
+        faults.append(loop.logged(rows, "fault_actuator").T)
+    faulty = np.concatenate(faults, axis=1) != 0  # (m, N + 1)
+    U = np.concatenate(inputs, axis=1).T  # (N + 1, m), a view of its contiguous transpose
     ks = check_indices(U, np.any(faulty[:, 1:] != faulty[:, :-1], axis=0) if len(faulty) else None)
-    return tolerance * _column_max(S) + ATOL, S, U, W, ks
+    return tolerance * np.max(largest, axis=0) + ATOL, outputs, W, ks
 
 
 def state_name(loop, entry: int) -> str:
@@ -183,11 +203,11 @@ def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) ->
     return checked_runs(loop, [(outputs, W, tolerance)], stacklevel=5)[0]
 
 
-def checked_runs(loop, runs, stacklevel: int = 4) -> list[dict | None]:
-    """:func:`checked_steps` of each run ``(outputs, W, tolerance)`` of one loop (:func:`step_errors`);
-    stacklevel: the warnings', counted from this function."""
+def checked_runs(loop, runs, stacklevel: int = 4, compiled: bool = False) -> list[dict | None]:
+    """:func:`checked_steps` of each run ``(outputs, W, tolerance)`` of one loop (:func:`step_errors`, compiled
+    as it says); stacklevel: the warnings', counted from this function."""
     metas = []
-    for (_, _, tolerance), error in zip(runs, step_errors(loop, runs)):
+    for (_, _, tolerance), error in zip(runs, step_errors(loop, runs, compiled)):
         if error is None:
             metas.append(None)
             continue

@@ -602,13 +602,13 @@ def simulate_system_scenario(scenario: SystemScenario, *, method: str = "fast", 
     return decided(scenario, result)
 
 
-def scenario_inputs(scenario: SystemScenario) -> np.ndarray:
-    """W (N + 1, n_w) of the scenario's run (:func:`~uvsym.sim.system_simulation.loop_inputs`): its
-    disturbances (constant or scheduled) plus its white disturbance noise, its seeded sensor-noise
-    draws and its faults' numbers."""
+def scenario_inputs(scenario: SystemScenario, compact: bool = False):
+    """W (N + 1, n_w) of the scenario's run (:func:`~uvsym.sim.system_simulation.loop_inputs`; compact as
+    it says): its disturbances (constant or scheduled) plus its white disturbance noise, its seeded
+    sensor-noise draws and its faults' numbers."""
     N = round(scenario.duration / scenario.step)
     d = scenario.d if scenario.disturbance_noise is None else scenario.d + scenario.disturbance_noise.draws(N)
-    return loop_inputs(scenario.loop, N, d, scenario.seed)
+    return loop_inputs(scenario.loop, N, d, scenario.seed, compact)
 
 
 def scenario_meta_arguments(scenario: SystemScenario) -> dict:

@@ -6,6 +6,7 @@ import numpy as np
 
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault, fault_parameters
+from uvsym.sim.inputs import CompactInputs
 from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
@@ -105,17 +106,26 @@ def simulate_system(plant: System, blocks, *, duration: float, dt: float, x0, me
                      sensor_faults=sensor_faults, substitutions=substitutions, rk4_tolerance=rk4_tolerance)
 
 
-def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0) -> np.ndarray:
+def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0, compact: bool = False):
     """W (N + 1, n_w) of a wired loop: times, seeded noise draws, disturbances d (constant (n_d,) or one
-    row per sample; default 0), the numbers of the loop's faults, substitution switches off.
+    row per sample; default 0), the numbers of the loop's faults, substitution switches off. compact: as
+    :class:`~uvsym.sim.inputs.CompactInputs` (the times, the draws and a varying d its columns), else dense.
     SimulationError when it cannot be held."""
     plant = loop.plant
     check_memory(memory_needed(N + 1, loop), f"{N * loop.dt:g} s at step {loop.dt:g} s ({N + 1} samples)")
-    W = sample_inputs(loop.n_w, N, loop.dt, plant.y.size, seed)  # one row per sample: [t, noise, d, theta, switches]
-    start = loop.env_columns.start
-    W[:, start:start + plant.d.size] = per_sample(np.zeros(plant.d.size) if d is None else d, plant.d.size, N, "d")
-    W[:, loop.fault_columns] = [value for fault in loop.faults for value in fault_parameters(fault)]
-    return W
+    n_noise, start = plant.y.size, loop.env_columns.start  # one row per sample: [t, noise, d, theta, switches]
+    d = np.zeros(plant.d.size) if d is None else np.asarray(d, dtype=float)
+    per_sample(d, plant.d.size, N, "d")
+    constant = np.zeros(loop.n_w)
+    constant[loop.fault_columns] = [value for fault in loop.faults for value in fault_parameters(fault)]
+    blocks, columns = [sample_inputs(1 + n_noise, N, loop.dt, n_noise, seed)], [np.arange(1 + n_noise)]
+    if d.ndim == 1:
+        constant[start:start + plant.d.size] = d
+    else:
+        blocks.append(d)
+        columns.append(np.arange(start, start + plant.d.size))
+    inputs = CompactInputs(constant, np.concatenate(columns).astype(np.int_), np.ascontiguousarray(np.hstack(blocks)))
+    return inputs if compact else inputs.dense()
 
 
 def run_wired(loop: WiredLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
