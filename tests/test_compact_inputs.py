@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from uvsym.errors import SimulationError
-from uvsym.sim.inputs import CompactInputs, compact, input_rows
+from uvsym.sim.inputs import CompactInputs, compact, input_column, input_rows
 from uvsym.sim.scenario import load_scenario
 from uvsym.sim.simulation import observer_blocks, prepare_run, scenario_arguments
 from uvsym.sim.system_scenario import parse_system_scenario, scenario_inputs
@@ -33,6 +33,8 @@ def test_a_table_compacts_to_its_varying_columns_and_back_exactly():
     np.testing.assert_array_equal(table.column(2), np.full(6, 3.5))
     np.testing.assert_array_equal(table.column(3), W[:, 3])
     assert input_rows(W, 1) is not None and np.array_equal(input_rows(W, 1), W[1])
+    np.testing.assert_array_equal(input_column(table, 3), input_column(W, 3))
+    np.testing.assert_array_equal(input_column(table, 2), W[:, 2])
 
 
 def test_compact_inputs_of_the_wrong_shapes_are_refused_naming_them():

@@ -33,7 +33,7 @@ from uvsym.codegen.cache import frozen, memoized
 from uvsym.codegen.compile import compile_lanes, vector_doubles
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
-from uvsym.sim.inputs import CompactInputs, input_rows
+from uvsym.sim.inputs import CompactInputs, input_column, input_rows
 from uvsym.sim.result import Signal, SimResult
 from uvsym.sim.run import CHUNK, check_chunk, run_closed_loop
 from uvsym.sim.scenario import Scenario
@@ -201,7 +201,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
                     if not (np.isfinite(rows).all() and np.isfinite(z[:, lane]).all()):
                         check_chunk(loop, "fast", start, input_rows(W_rows, slice(None)), rows, z[:, lane], run.guard)
                     elif run.guard is not None:
-                        run.guard(_times(W_rows), rows)
+                        run.guard(input_column(W_rows, 0), rows)
                 except SimulationError as exc:
                     raise SimulationError(f"run {names[first + lane]}: {exc}") from None
         last = np.asarray(_final(loop.discrete, lanes)(z, np.stack([input_rows(W, N) for W in lane_W], axis=-1))[2])
@@ -216,13 +216,8 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
             meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}
             if errors.get(lane) is not None:
                 meta["rk4_error"] = errors[lane]
-            results.append(SimResult(_times(W).copy(), signals, meta))
+            results.append(SimResult(input_column(W, 0).copy(), signals, meta))
     return results
-
-
-def _times(W) -> np.ndarray:
-    """(k,) the sample times (s), column 0 of a run's W (dense or compact)."""
-    return W.column(0) if isinstance(W, CompactInputs) else W[:, 0]
 
 
 @memoized(16)
@@ -233,7 +228,8 @@ def _final(discrete, lanes: int):
 
 def _scalar(run: PreparedRun, compiled: bool) -> SimResult:
     """One run on the scalar fast path (the fallback of :func:`run_lanes`)."""
-    W = input_rows(run.W, slice(None)).copy()  # the runner writes a supervisor's decisions into its W
+    # the runner writes a supervisor's decisions into its W: the run's own copy
+    W = run.W.dense() if isinstance(run.W, CompactInputs) else run.W.copy()
     result, timing = run_closed_loop(run.loop, run.z0, W, compiled=compiled, guard=run.guard,
                                      rk4_tolerance=run.rk4_tolerance)
     return SimResult(result.t, result.signals, {**run.meta, **timing})

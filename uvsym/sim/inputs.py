@@ -15,7 +15,7 @@ import numpy as np
 
 from uvsym.errors import SimulationError
 
-__all__ = ["CompactInputs", "compact", "input_rows"]
+__all__ = ["CompactInputs", "compact", "input_column", "input_rows"]
 
 
 @dataclass(frozen=True)
@@ -81,3 +81,8 @@ def compact(W: np.ndarray) -> CompactInputs:
 def input_rows(W, samples) -> np.ndarray:
     """The dense rows ``W[samples]`` of a table W, dense (ndarray) or compact."""
     return W.dense(samples) if isinstance(W, CompactInputs) else W[samples]
+
+
+def input_column(W, j: int) -> np.ndarray:
+    """(k,) column j of a table W, dense (a view) or compact."""
+    return W.column(j) if isinstance(W, CompactInputs) else W[:, j]
