@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 import casadi as ca
+import numpy as np
 import pytest
 
 from uvsym.errors import FaultError
@@ -128,3 +129,19 @@ def test_profile_edges_that_are_allowed():
     assert phi(Profile("intermittent", onset=0.0, period=1.0, duty=1.0), 0.999) == 1.0
     assert phi(Profile("step", onset=0.0), 0.0) == 1.0
     assert phi(Profile("step", onset=3.0, end=math.inf), 1e9) == 1.0
+
+
+@pytest.mark.parametrize("profile", [
+    Profile("step", onset=0.73), Profile("step", onset=0.5, end=1.37),
+    Profile("ramp", onset=0.2, duration=0.5, end=2.05),
+    Profile("incipient", onset=0.31, rate=4.0), Profile("intermittent", onset=0.25, period=0.3, duty=0.4, end=2.62),
+    Profile("intermittent", onset=0.1, period=0.2, duty=1.0)])
+def test_jumps_are_the_samples_over_which_phi_is_discontinuous(profile):
+    """phi evaluated on a grid 1000 times finer than the samples: a sample holds a jump exactly where two
+    neighbouring fine values differ by more than a continuous profile could change over the fine step."""
+    dt, N, fine = 0.1, 30, 1000
+    t = dt * np.arange(N)
+    values = np.asarray(ca.evalf(profile.phi(ca.DM(np.linspace(0.0, N * dt, N * fine + 1))))).ravel()
+    steps = np.abs(np.diff(values)) > 0.05  # a ramp or incipient moves at most 4 * 1e-4 per fine step here
+    expected = np.array([steps[k * fine:(k + 1) * fine].any() for k in range(N)])
+    assert profile.jumps(t, dt).tolist() == expected.tolist()

@@ -1,6 +1,7 @@
 """The guides' code runs as written: in a folder holding a copy of examples/dc_motor/, each page's
 ``# file: NAME`` TOML blocks are written, its Python blocks run in one namespace, and every
-``uvsym ...`` line of its sh blocks runs through the command's entry point and succeeds."""
+``uvsym ...`` line of its sh blocks runs through the command's entry point and succeeds (a line for a
+cross target skips, naming what is missing, where its toolchain is not installed)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from pathlib import Path
 import pytest
 
 from uvsym.cli import main
+from uvsym.codegen.target_run import missing_tools
+from uvsym.codegen.targets import TARGETS
 
 ROOT = Path(__file__).resolve().parents[1]
 GUIDES = sorted((ROOT / "docs" / "guides").glob("*.md"))
@@ -45,7 +48,16 @@ def test_the_guide_runs_as_written(page, tmp_path, monkeypatch, capsys):
         elif language == "sh":
             for line in code.splitlines():
                 if line.startswith("uvsym "):
+                    _needs_the_target_of(shlex.split(line))
                     assert main(shlex.split(line)[1:]) == 0, f"{where}: {line}\n{capsys.readouterr().err[-3000:]}"
                     ran += 1
     assert ran, f"{page.name} has no code that runs"
     assert capsys.readouterr().out.strip()
+
+
+def _needs_the_target_of(words: list[str]) -> None:
+    """Skip, naming the missing tools, a command whose ``--target`` toolchain is not installed."""
+    if "--target" in words:
+        missing = missing_tools(TARGETS[words[words.index("--target") + 1]])
+        if missing:
+            pytest.skip(f"{', '.join(missing)} not installed (scripts/install-arm-toolchain.sh installs them)")

@@ -27,12 +27,13 @@ from types import MappingProxyType
 from typing import Callable, ClassVar
 
 import casadi as ca
+import numpy as np
 
 from uvsym.errors import FaultError, IdentifiabilityError
 
 __all__ = ["PROFILES", "ACTUATOR_KINDS", "SENSOR_KINDS", "ActuatorKind", "SensorKind", "actuator_kind", "sensor_kind",
            "Profile", "ActuatorFault", "SensorFault", "apply_actuator_faults", "apply_sensor_faults",
-           "FAULT_PARAMETERS", "fault_parameters", "fault_shape", "symbolic_fault"]
+           "actuator_fault_affine", "FAULT_PARAMETERS", "fault_parameters", "fault_shape", "symbolic_fault"]
 
 PROFILES = ("step", "ramp", "incipient", "intermittent")
 TIME_TOLERANCE = 1e-9  # s
@@ -227,6 +228,23 @@ class Profile:
             shape = phase < self.duty * self.period
         return ca.if_else(self.active(t), shape, 0.0)
 
+    def jumps(self, t: np.ndarray, dt: float) -> np.ndarray:
+        """(len(t),) True where phi jumps within the sample from t (s) to t + dt: its onset (step,
+        intermittent), each switch of an intermittent profile, its end (a time within ``TIME_TOLERANCE``
+        of a sample counts as at it, as :meth:`active` has it). t ascending."""
+        t = np.asarray(t, dtype=float)
+        last = min(self.end, float(t[-1]) + dt) if t.size else self.onset
+        edges = [self.onset] if self.kind in ("step", "intermittent") else []
+        on_at_end = True
+        if self.kind == "intermittent" and self.duty < 1.0:
+            cycles = self.onset + self.period * np.arange(math.floor((last - self.onset) / self.period) + 2)
+            edges += [e for e in (*cycles[1:], *(cycles + self.duty * self.period)) if e < self.end]
+            on_at_end = (self.end - self.onset) % self.period < self.duty * self.period
+        if math.isfinite(self.end) and on_at_end:
+            edges.append(self.end)
+        edges = np.sort(np.asarray(edges, dtype=float)) - TIME_TOLERANCE
+        return np.searchsorted(edges, t + dt, side="right") > np.searchsorted(edges, t, side="right")
+
 
 @dataclass(frozen=True)
 class ActuatorFault:
@@ -346,6 +364,35 @@ def _check_index_type(index, what: str) -> None:
 def _check_index(index: int, size: int, what: str) -> None:
     if not 0 <= index < size:
         raise FaultError(f"{what} index {index} is out of range for {size} {what}s")
+
+
+def actuator_fault_affine(faults: tuple[ActuatorFault, ...], m: int, phis,
+                          shape: tuple[int, ...]) -> tuple[list[tuple[int, int]], np.ndarray]:
+    """The faults composed, as affine maps of the actuator values: ``applied = a + D a + B``.
+
+    phis: one array of ``shape`` P per fault, its profile's phi at the times wanted. Returns
+    (parts, folded of shape ``(len(parts), *P)``): parts the (0, actuator) of each D and (1, actuator) of each B the
+    faults can make non-zero (a D where a gain is not 1, a B where a shift is not 0), sorted; every other
+    D and B is 0. A fault ``v -> v + phi (g v + b - v)`` (``(g, b) = kind.affine(value)``) maps (D, B) to
+    ``(D + c + c D, B + c B + phi b)`` with ``c = phi (g - 1)``, faults in order, composed in place in one
+    buffer (temporaries of a run's length cost their page faults on every call).
+    """
+    affine = []
+    for fault in faults:
+        _check_index(fault.actuator, m, "actuator")
+        affine.append((fault.actuator, *fault.kind_object.affine(fault.value)))
+    parts = sorted({(part, actuator) for actuator, gain, shift in affine
+                    for part, acts in ((0, gain != 1.0), (1, shift != 0.0)) if acts})
+    where = {part: i for i, part in enumerate(parts)}
+    folded, c, scratch = np.zeros((len(parts), *shape)), np.empty(shape), np.empty(shape)
+    for phi, (actuator, gain, shift) in zip(phis, affine):
+        np.multiply(phi, gain - 1.0, out=c)
+        for part in (0, 1):
+            if (part, actuator) in where:  # D + c + c D, B + c B + phi b
+                value = folded[where[part, actuator]]
+                value += np.multiply(c, value, out=scratch)
+                value += c if part == 0 else np.multiply(phi, shift, out=scratch)
+    return parts, folded
 
 
 def apply_actuator_faults(u, t, faults: tuple[ActuatorFault, ...]):

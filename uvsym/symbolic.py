@@ -9,7 +9,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4", "as_column", "has_nan_constant"]
+__all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4", "rk4_stage_times", "as_column",
+           "has_nan_constant"]
 
 _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
@@ -69,6 +70,13 @@ def rk4(ode, s, h: float, steps: int, *args, t=0.0):
         k4 = ode(s + dh * k3, *args, ti + dh)
         s = s + dh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return s
+
+
+def rk4_stage_times(t: np.ndarray, h: float, steps: int) -> np.ndarray:
+    """(len(t), 2 steps + 1) the distinct stage times of :func:`rk4` (``steps`` steps over ``h`` s) from each
+    start time t (s), formed as it forms them: node j at ``(t + (j // 2) dh) + dh / 2`` for odd j, dh = h / steps."""
+    dh = h / steps
+    return np.column_stack([t + (j // 2) * dh + (dh / 2 if j % 2 else 0.0) for j in range(2 * steps + 1)])
 
 
 def as_column(value) -> ca.SX:

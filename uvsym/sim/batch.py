@@ -208,8 +208,9 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         for lane, out in enumerate(outputs):
             out[N] = last[:, lane]
         wall = time.perf_counter() - started
-        checked = [(lane, (out, W, run.rk4_tolerance)) for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))
-                   if run.rk4_tolerance is not None]  # as the scalar path checks them, all in one call
+        checked = [(lane, (out, W, run.rk4_tolerance, run.actuator_faults))  # as the scalar path checks them,
+                   for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))  # all in one call
+                   if run.rk4_tolerance is not None]
         errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked], compiled=True)))
         for lane, (run, W, out) in enumerate(zip(group, Ws, outputs)):  # views of the run's rows: no copy
             signals = {name: Signal(out[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
@@ -231,5 +232,5 @@ def _scalar(run: PreparedRun, compiled: bool) -> SimResult:
     # the runner writes a supervisor's decisions into its W: the run's own copy
     W = run.W.dense() if isinstance(run.W, CompactInputs) else run.W.copy()
     result, timing = run_closed_loop(run.loop, run.z0, W, compiled=compiled, guard=run.guard,
-                                     rk4_tolerance=run.rk4_tolerance)
+                                     rk4_tolerance=run.rk4_tolerance, actuator_faults=run.actuator_faults)
     return SimResult(result.t, result.signals, {**run.meta, **timing})

@@ -32,13 +32,13 @@ import numpy as np
 from uvsym.codegen.cache import memoized
 from uvsym.conventions import FORCE_LABELS
 from uvsym.errors import SimulationError
-from uvsym.faults import ActuatorFault, SensorFault, _check_index, apply_actuator_faults, apply_sensor_faults
+from uvsym.faults import ActuatorFault, SensorFault, actuator_fault_affine, apply_actuator_faults, apply_sensor_faults
 from uvsym.models.actuators import saturate
 from uvsym.models.model import Model
 from uvsym.observers.base import Observer
 from uvsym.sim.controllers import Autopilot
 from uvsym.sim.loop import SampledLoop, logged_signals
-from uvsym.symbolic import rk4
+from uvsym.symbolic import rk4, rk4_stage_times
 
 __all__ = ["ClosedLoop", "build_closed_loop", "actuator_fault_table"]
 
@@ -161,6 +161,9 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     s, uc, env, ts = ca.SX.sym("s", n_s), ca.SX.sym("u_cmd", m), ca.SX.sym("env", 2), ca.SX.sym("t")
     plant_ode = ca.Function("plant_ode", [s, uc, env, ts], [s_dot(s, apply_actuator_faults(s[n:], ts, actuator_faults),
                                                                  uc, env)], ["s", "u_cmd", "env", "t"], ["s_dot"])
+    d, b = ca.SX.sym("d", m), ca.SX.sym("b", m)
+    fault_ode = ca.Function("plant_fault_ode", [s, uc, env, d, b], [s_dot(s, s[n:] + (d * s[n:] + b), uc, env)],
+                            ["s", "u_cmd", "env", "d", "b"], ["s_dot"])
     half = dt / (2 * substeps)
 
     def stage_ode(s, u_cmd, env, offset):
@@ -174,7 +177,8 @@ def build_closed_loop(model: Model, controller: Autopilot, dt: float, *,
     step = ca.Function("closed_loop_step", [z, w], [ca.densify(ca.vertcat(s_next, z_disc)), out],
                        ["z", "w"], ["z_next", "out"], {"cse": True})
     return ClosedLoop(model=model, dt=dt, substeps=substeps, n_z=n_z, n_w=n_w, n_s=n_s, discrete=discrete,
-                      plant_ode=plant_ode, step=step, layout=layout, observer_slices=observer_slices,
+                      plant_ode=plant_ode, actuator_faults=tuple(actuator_faults), fault_ode=fault_ode,
+                      step=step, layout=layout, observer_slices=observer_slices,
                       observers={obs.name: obs for obs in observers}, signals=signals, env_columns=slice(1 + n, 3 + n),
                       correction_columns=slice(3 + n, 3 + n + m * m + m), fault_columns=slice(3 + n + m * m + m, n_w))
 
@@ -183,32 +187,12 @@ def actuator_fault_table(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], N:
     """(columns (n,), values (N + 1, n)): the fault columns (within w's fault block, ascending) that ``faults``
     can make non-zero and their values; the block is ``[D_0 .. D_J-1, B_0 .. B_J-1]``, each (m,), actuator a of
     stage j at ``j m + a``: per stage j the (D_j, B_j) with ``applied = a + D_j a + B_j`` at the stage time
-    ``k dt + j dt / (2 substeps)`` of sample k = 0..N, faults composed in order (every other column 0).
-
-    A fault ``v -> v + phi (g v + b - v)`` (``(g, b) = kind.affine(value)``) maps ``(D, B)`` to
-    ``(D + c + c D, B + c B + phi b)`` with ``c = phi (g - 1)``.
+    ``k dt + j dt / (2 substeps)`` of sample k = 0..N, faults composed in order
+    (:func:`~uvsym.faults.actuator_fault_affine`; every other column 0).
     """
     m, stages = loop.model.n_inputs, 2 * loop.substeps + 1
-    affine = []
-    for fault in faults:
-        _check_index(fault.actuator, m, "actuator")
-        affine.append((fault.actuator, *fault.kind_object.affine(fault.value)))
-    # the columns a fault can make non-zero: an actuator's D where one of its gains is not 1, its B where one
-    # of its shifts is not 0 (a gain only scales a B some shift made), each over its stages
-    parts = sorted({(part, actuator) for actuator, gain, shift in affine
-                    for part, acts in ((0, gain != 1.0), (1, shift != 0.0)) if acts})
-    where = {part: i for i, part in enumerate(parts)}
-    # one buffer (parts, N + 1, J) composed in place, faults in order: temporaries of a run's length cost
-    # their page faults on every call
-    folded, c, scratch = np.zeros((len(parts), N + 1, stages)), np.empty((N + 1, stages)), np.empty((N + 1, stages))
-    for fault, (actuator, gain, shift) in zip(faults, affine):
-        phi = _stage_phi(fault.profile, loop.dt, loop.substeps, N)
-        np.multiply(phi, gain - 1.0, out=c)
-        for part in (0, 1):
-            if (part, actuator) in where:  # D + c + c D, B + c B + phi b
-                value = folded[where[part, actuator]]
-                value += np.multiply(c, value, out=scratch)
-                value += c if part == 0 else np.multiply(phi, shift, out=scratch)
+    parts, folded = actuator_fault_affine(faults, m, [_stage_phi(f.profile, loop.dt, loop.substeps, N)
+                                                      for f in faults], (N + 1, stages))  # (parts, N + 1, J)
     columns = [part * stages * m + j * m + actuator for part, actuator in parts for j in range(stages)]
     order = np.argsort(columns, kind="stable")
     table = np.ascontiguousarray(folded.transpose(1, 0, 2).reshape(N + 1, -1)[:, order])
@@ -217,14 +201,9 @@ def actuator_fault_table(loop: ClosedLoop, faults: tuple[ActuatorFault, ...], N:
 
 @functools.lru_cache(maxsize=32)
 def _stage_phi(profile, dt: float, substeps: int, N: int) -> np.ndarray:
-    """phi (N + 1, J) at the stage times, evaluated by CasADi as the symbolic step would (kept: reruns reuse it).
-
-    Stage j of sample k is at ``(k dt + (j // 2) dh) + dh / 2`` for odd j (``dh = dt / substeps``), as
-    :func:`uvsym.symbolic.rk4` forms its times (exactly so for one substep).
-    """
-    dh = dt / substeps
-    t = dt * np.arange(N + 1)  # as sample_inputs writes them
-    times = np.column_stack([t + (j // 2) * dh + (dh / 2 if j % 2 else 0.0) for j in range(2 * substeps + 1)])
+    """phi (N + 1, J) at the stage times of each sample (:func:`~uvsym.symbolic.rk4_stage_times`), evaluated by
+    CasADi as the symbolic step would (kept: reruns reuse it)."""
+    times = rk4_stage_times(dt * np.arange(N + 1), dt, substeps)  # sample times as sample_inputs writes them
     phi = np.asarray(profile.phi(ca.DM(times.reshape(-1)))).reshape(times.shape)
     phi.setflags(write=False)
     return phi

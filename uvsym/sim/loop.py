@@ -29,6 +29,9 @@ class SampledLoop:
     (``substeps`` RK4 steps of the plant per sample); layout: part of z -> slice. env_columns:
     where w holds the plant's environment; correction_columns: (vec(S), o) of a command
     correction, or None; substitution_columns: measurement channel -> its switch column.
+    fault_ode(s, u_cmd, env, d, b) -> s_dot with the actuators delivering ``a + d a + b`` (d, b (m,)), for a
+    loop whose w holds its actuator faults as such (D, B) stage columns, and ``actuator_faults`` the faults
+    its plant_ode holds; None for a loop whose plant_ode reads its faults from w.
     """
 
     dt: float
@@ -44,6 +47,8 @@ class SampledLoop:
     env_columns: slice
     correction_columns: slice | None = None
     substitution_columns: dict = field(default_factory=dict)
+    fault_ode: ca.Function | None = None
+    actuator_faults: tuple | None = None
 
     def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """(s (k, n_s), u_cmd (k, m)): the integrated plant state and the held plant inputs at the samples

@@ -70,7 +70,8 @@ class Supervisor(Protocol):
 def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method: str = "fast",
                     supervisor: Supervisor | None = None, options: dict | None = None,
                     compiled: bool = True, progress=None, guard=None,
-                    rk4_tolerance: float | None = TOLERANCE) -> tuple[SimResult, dict]:
+                    rk4_tolerance: float | None = TOLERANCE,
+                    actuator_faults: tuple | None = None) -> tuple[SimResult, dict]:
     """Simulate ``len(W) - 1`` samples from z0; W: (N + 1, n_w) per-sample inputs, one row a sample.
 
     The decision columns of W are overwritten by the supervisor's decisions. ``guard(t, out)``
@@ -79,7 +80,8 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
     cause is named rather than its NaN. Returns the result (samples at every grid time, meta
     without the caller's part) and timing information, with the fast path's ``rk4_error`` on
     sampled steps (:mod:`uvsym.sim.step_error`; an IntegrationAccuracyWarning past
-    ``rk4_tolerance``, None: not checked).
+    ``rk4_tolerance``, None: not checked). actuator_faults: the run's, for that check, where they are not the
+    loop's own (a loop shared by runs of other faults, which W carries); None: the loop's.
 
     Raises
     ------
@@ -119,7 +121,7 @@ def run_closed_loop(loop: SampledLoop, z0: np.ndarray, W: np.ndarray, *, method:
             progress((start + k) / N)
     outputs[N] = np.asarray(loop.discrete(z, W[N])[2]).ravel()
     wall = time.perf_counter() - started
-    checked = checked_steps(loop, outputs, W, tolerance) if tolerance is not None else None
+    checked = checked_steps(loop, outputs, W, tolerance, actuator_faults) if tolerance is not None else None
     # views of the one logged table (their columns are disjoint): no copy, half the memory
     signals = {name: Signal(outputs[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
     timing = {"wall_s": wall, "build_s": build_s}
@@ -250,8 +252,8 @@ def grid(duration: float, dt: float) -> int:
 
 
 def memory_needed(samples: int, loop: SampledLoop) -> int:
-    """Bytes a run of ``samples`` samples may hold at once: the per-sample inputs W, the logged outputs
-    and one copy of them (float64; a batch rearranges its lanes' outputs, a scalar run's result holds views)."""
+    """Bytes a run of ``samples`` samples may hold at once, at most: its per-sample inputs W dense (a batch's
+    lanes hold only W's varying columns), its logged outputs and one copy of them (float64)."""
     return 8 * samples * (loop.n_w + 2 * loop.discrete.size1_out("out"))
 
 

@@ -34,7 +34,8 @@ __all__ = ["simulate", "simulate_scenario", "observer_blocks", "scenario_observe
 class PreparedRun:
     """A run of :func:`simulate` ready for the runner: its loop, initial state z0 (n_z,), per-sample
     inputs W (N + 1, n_w; dense, or compact for the lanes), the attitude guard (None below 6 DOF), the
-    result's meta (no timings) and the fast path's step-error tolerance (None: not checked)."""
+    result's meta (no timings), the fast path's step-error tolerance (None: not checked) and the run's
+    actuator faults where its loop is shared (which W carries; None: the loop's own)."""
 
     loop: ClosedLoop
     z0: np.ndarray
@@ -42,6 +43,7 @@ class PreparedRun:
     guard: Callable | None
     meta: dict
     rk4_tolerance: float | None = TOLERANCE
+    actuator_faults: tuple | None = None
 
 
 def simulate(model: Model, controller: Autopilot, *, duration: float, dt: float, eta0, nu0,
@@ -124,7 +126,8 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
     current_in_w: read a constant current from W rather than build it into the step (so runs with
     different currents share one compiled step, as the lanes of a batch do). loop: one already built
     for this model, controller, dt, sensor faults, observers and substeps with ``current=None``, to
-    share (its fixed-step ``step`` takes the actuator faults from W; its ``plant_ode`` is not used).
+    share (its fixed-step ``step`` takes the actuator faults from W, its step check the run's
+    ``actuator_faults``; its ``plant_ode``, the integrators', holds none: method ``fast`` only).
     compact: W as :class:`~uvsym.sim.inputs.CompactInputs` (what the lanes read), else dense.
     """
     N = grid(duration, dt)
@@ -137,7 +140,11 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
             Tzyx(x0[3], x0[4])
         except KinematicsError as exc:
             raise KinematicsError(f"eta0: {exc}") from None
-    if loop is None:
+    shared = loop is not None
+    if shared and method != "fast" and loop.actuator_faults != tuple(actuator_faults):
+        raise SimulationError(f"method {method!r} integrates the shared loop's plant_ode, which holds other actuator "
+                              "faults than this run's; share a loop with method 'fast' only")
+    if not shared:
         loop = build_closed_loop(model, controller, dt, actuator_faults=tuple(actuator_faults),
                                  sensor_faults=tuple(sensor_faults), observers=tuple(observers), substeps=substeps,
                                  current=tuple(env) if env.shape == (2,) and not current_in_w else None)
@@ -163,7 +170,8 @@ def prepare_run(model: Model, controller: Autopilot, *, duration: float, dt: flo
             "seed": seed, "observers": [obs.name for obs in observers],
             "actuator_faults": [fault_summary(f, model.input_labels[f.actuator]) for f in actuator_faults],
             "sensor_faults": [fault_summary(f, model.state_labels[f.channel]) for f in sensor_faults]}
-    return PreparedRun(loop, z0, W, _attitude_guard(loop) if dof == 6 else None, meta)
+    return PreparedRun(loop, z0, W, _attitude_guard(loop) if dof == 6 else None, meta,
+                       actuator_faults=tuple(actuator_faults) if shared else None)
 
 
 def _run_inputs(loop: ClosedLoop, N: int, dt: float, env: np.ndarray, faults: tuple[ActuatorFault, ...], n_noise: int,

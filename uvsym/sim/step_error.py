@@ -8,7 +8,10 @@ run's own state (read back from its log, :meth:`~uvsym.sim.loop.SampledLoop.inte
 ``substeps`` and with ``2 substeps`` RK4 steps; Richardson's estimate of the first one's error is
 ``e = (s_n - s_2n) 16 / 15``. A step during which an actuator fault switches on or off is not
 checked: RK4's last stage there already sees the next sample's fault (the smear of
-:mod:`uvsym.sim.wiring`, at most one sample), which no number of substeps removes. Each entry's
+:mod:`uvsym.sim.wiring`, at most one sample), which no number of substeps removes; such steps are
+found from the run's fault profiles (:meth:`~uvsym.faults.Profile.jumps`) where the loop carries its
+actuator faults in w (the vehicle loop, whose redone steps then take the faults at every stage time
+of both), else where the logged ``fault_actuator`` turns zero or non-zero. Each entry's
 error is measured against the entry's scale over the run, ``tolerance (max_k |s_k,i|) + ATOL``, and
 the largest ratio is reported with the substeps that would meet the tolerance (the error over a
 sample falls as ``substeps^-4``). Sampled steps: numerical evidence, never a bound on every sample.
@@ -26,8 +29,9 @@ import numpy as np
 from uvsym.codegen.cache import memoized
 from uvsym.codegen.compile import DEFAULT_FLAGS, compile_function
 from uvsym.errors import CodegenError, IntegrationAccuracyWarning, SimulationError
-from uvsym.sim.inputs import input_rows
-from uvsym.symbolic import rk4
+from uvsym.faults import actuator_fault_affine
+from uvsym.sim.inputs import input_column, input_rows
+from uvsym.symbolic import rk4, rk4_stage_times
 
 __all__ = ["CHECKS", "TOLERANCE", "StepError", "check_indices", "check_tolerance",
            "checked_runs", "checked_steps", "state_name", "step_error", "step_errors"]
@@ -110,6 +114,25 @@ def _doubled(plant_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
 
 
 @memoized(16)
+def _doubled_by_faults(fault_ode: ca.Function, dt: float, substeps: int) -> ca.Function:
+    """(s, u, env, D, B) -> [s after substeps RK4 steps; s after 2 substeps] over one sample of dt s, the
+    actuators delivering ``a + D_i a + B_i`` at node i of the fine steps' stage times (D, B (m nodes,),
+    actuator a at ``i m + a``, node i at ``i dt / (4 substeps)``; the coarse steps' stages at the even nodes)."""
+    m = fault_ode.size1_in(3)
+    nodes = 4 * substeps + 1
+    s, u = ca.SX.sym("s", fault_ode.size1_in(0)), ca.SX.sym("u", fault_ode.size1_in(1))
+    env, D, B = ca.SX.sym("env", fault_ode.size1_in(2)), ca.SX.sym("D", m * nodes), ca.SX.sym("B", m * nodes)
+    quarter = dt / (4 * substeps)
+
+    def ode(s, u, env, offset):
+        i = round(offset / quarter)
+        return fault_ode(s, u, env, D[i * m:(i + 1) * m], B[i * m:(i + 1) * m])
+
+    coarse, fine = (rk4(ode, s, dt, n, u, env) for n in (substeps, 2 * substeps))
+    return ca.Function("doubled_by_faults", [s, u, env, D, B], [coarse, fine])
+
+
+@memoized(16)
 def _mapped(doubled: ca.Function, runs: int, compiled: bool) -> ca.Function:
     """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column; compiled: its C
     (from the compile cache; CasADi's virtual machine where there is no compiler)."""
@@ -130,24 +153,22 @@ def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> St
     """The largest error of the checked steps of a finished run (module docstring): outputs (N + 1, n_out)
     its logged rows, W (N + 1, n_w) its inputs (dense or compact). None for a discrete-time plant, a loop
     that cannot read its integrated state back, or a run of no step."""
-    return step_errors(loop, [(outputs, W, tolerance)])[0]
+    return step_errors(loop, [(outputs, W, tolerance, None)])[0]
 
 
 def step_errors(loop, runs, compiled: bool = False) -> list[StepError | None]:
-    """:func:`step_error` of each run ``(outputs, W, tolerance)`` of one loop, every checked step of every run
-    in one call of the doubled step mapped over them all (compiled: its C, as compiled loops want)."""
+    """:func:`step_error` of each run ``(outputs, W, tolerance, faults)`` of one loop, every checked step of every
+    run in one call of the doubled step mapped over them all (compiled: its C, as compiled loops want). faults:
+    the run's actuator faults where they are not the loop's own (``loop.actuator_faults``: a loop shared by
+    runs of other faults, which its w carries), else None."""
     if loop.plant_ode is None:
         return [None] * len(runs)
-    plans = [_plan(loop, outputs, W, tolerance) for outputs, W, tolerance in runs]
-    checked = [plan for plan in plans if plan is not None and plan[-1]]
-    if checked:  # the rows of each run's checked steps (its last one repeated to fill CHECKS columns)
-        rows = [ks + ks[-1:] * (CHECKS - len(ks)) for *_, ks in checked]
-        arguments = [np.concatenate(parts, axis=1) for parts in zip(*(
-            (S_r.T, U_r.T, W_r[:, loop.env_columns].T, W_r[:, 0][None, :])
-            for (_, outputs, W, _), r in zip(checked, rows)
-            for (S_r, U_r), W_r in [(loop.integrated(outputs[r]), input_rows(W, r))]))]
-        doubled = _doubled(loop.plant_ode, loop.dt, loop.substeps)
-        coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(checked), compiled)(*arguments))
+    faults = [loop.actuator_faults if run_faults is None else run_faults for *_, run_faults in runs]
+    plans = [_plan(loop, outputs, W, tolerance, run_faults)
+             for (outputs, W, tolerance, _), run_faults in zip(runs, faults)]
+    checked = [i for i, plan in enumerate(plans) if plan is not None and plan[-1]]
+    if checked:
+        coarse, fine = _redone(loop, [plans[i] for i in checked], [faults[i] for i in checked], compiled)
     errors, i = [], 0
     for plan in plans:
         if plan is None:
@@ -171,22 +192,61 @@ def step_errors(loop, runs, compiled: bool = False) -> list[StepError | None]:
     return errors
 
 
-def _plan(loop, outputs: np.ndarray, W, tolerance: float):
+def _redone(loop, plans, faults, compiled: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(coarse, fine), each (CHECKS len(plans), n_s): the checked steps of each plan redone from the run's logged
+    state with ``substeps`` and ``2 substeps`` RK4 steps (its last one repeated to fill CHECKS rows); a loop
+    with a ``fault_ode`` takes each run's actuator faults at the fine steps' stage times."""
+    arguments = []
+    for (_, outputs, W, ks), run_faults in zip(plans, faults):
+        rows = ks + ks[-1:] * (CHECKS - len(ks))
+        (S_r, U_r), W_r = loop.integrated(outputs[rows]), input_rows(W, rows)
+        last = _stage_faults(loop, run_faults, W_r[:, 0]) if loop.fault_ode is not None else (W_r[:, 0][None, :],)
+        arguments.append((S_r.T, U_r.T, W_r[:, loop.env_columns].T, *last))
+    arguments = [np.concatenate(parts, axis=1) for parts in zip(*arguments)]
+    doubled = _doubled_by_faults(loop.fault_ode, loop.dt, loop.substeps) if loop.fault_ode is not None \
+        else _doubled(loop.plant_ode, loop.dt, loop.substeps)
+    coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(plans), compiled)(*arguments))
+    return coarse, fine
+
+
+def _stage_faults(loop, faults, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(D, B), each (m nodes, len(t)): the actuator faults' ``applied = a + D a + B`` at the stage times of
+    ``2 substeps`` RK4 steps over the sample from each t (node i, actuator a at ``i m + a``)."""
+    m = loop.fault_ode.size1_in(3)
+    times = rk4_stage_times(t, loop.dt, 2 * loop.substeps)  # (len(t), nodes)
+    phis = [np.asarray(fault.profile.phi(ca.DM(times.reshape(-1)))).reshape(times.shape) for fault in faults]
+    parts, folded = actuator_fault_affine(faults, m, phis, times.shape)
+    dense = np.zeros((2, len(t), times.shape[1], m))
+    for (part, actuator), values in zip(parts, folded):
+        dense[part, :, :, actuator] = values
+    return dense[0].reshape(len(t), -1).T, dense[1].reshape(len(t), -1).T
+
+
+def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults):
     """(scale, outputs, W, checked samples) of a run's step check, or None where nothing can be checked. The
-    logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small)."""
+    logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small). The steps where an
+    actuator fault switches: from ``faults`` (its profiles' jumps) where given, else where the logged
+    ``fault_actuator`` turns zero or non-zero."""
     if len(W) < 2 or loop.integrated(outputs[:1]) is None:
         return None
-    largest, inputs, faults = [], [], []
+    largest, inputs, faulty = [], [], []
     for start in range(0, len(outputs), _ROWS):
         rows = outputs[start:start + _ROWS]
         S, U = loop.integrated(rows)
         largest.append(_column_max(S))
         inputs.append(U.T)
-        faults.append(loop.logged(rows, "fault_actuator").T)
-    faulty = np.concatenate(faults, axis=1) != 0  # (m, N + 1)
+        if faults is None:
+            faulty.append(loop.logged(rows, "fault_actuator").T != 0)
     U = np.concatenate(inputs, axis=1).T  # (N + 1, m), a view of its contiguous transpose
-    ks = check_indices(U, np.any(faulty[:, 1:] != faulty[:, :-1], axis=0) if len(faulty) else None)
-    return tolerance * np.max(largest, axis=0) + ATOL, outputs, W, ks
+    if faults is None:
+        faulty = np.concatenate(faulty, axis=1)  # (m, N + 1)
+        switching = np.any(faulty[:, 1:] != faulty[:, :-1], axis=0) if len(faulty) else None
+    else:
+        t = input_column(W, 0)[:-1]
+        switching = np.zeros(len(t), dtype=bool)
+        for fault in faults:
+            switching |= fault.profile.jumps(t, loop.dt)
+    return tolerance * np.max(largest, axis=0) + ATOL, outputs, W, check_indices(U, switching)
 
 
 def state_name(loop, entry: int) -> str:
@@ -196,18 +256,18 @@ def state_name(loop, entry: int) -> str:
     return f"x.{labels[entry]}" if entry < len(labels) else f"the integrated state s[{entry}] (an actuator)"
 
 
-def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> dict | None:
-    """The step error of a finished run (:func:`step_error`) as the result's ``rk4_error`` meta, with an
-    IntegrationAccuracyWarning (naming the state, the time and the substeps that would do) when it
-    misses the tolerance; None where nothing was checked."""
-    return checked_runs(loop, [(outputs, W, tolerance)], stacklevel=5)[0]
+def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float, faults=None) -> dict | None:
+    """The step error of a finished run (:func:`step_error`; faults as :func:`step_errors` has them) as the
+    result's ``rk4_error`` meta, with an IntegrationAccuracyWarning (naming the state, the time and the
+    substeps that would do) when it misses the tolerance; None where nothing was checked."""
+    return checked_runs(loop, [(outputs, W, tolerance, faults)], stacklevel=5)[0]
 
 
 def checked_runs(loop, runs, stacklevel: int = 4, compiled: bool = False) -> list[dict | None]:
-    """:func:`checked_steps` of each run ``(outputs, W, tolerance)`` of one loop (:func:`step_errors`, compiled
+    """:func:`checked_steps` of each run ``(outputs, W, tolerance, faults)`` of one loop (:func:`step_errors`, compiled
     as it says); stacklevel: the warnings', counted from this function."""
     metas = []
-    for (_, _, tolerance), error in zip(runs, step_errors(loop, runs, compiled)):
+    for (_, _, tolerance, _), error in zip(runs, step_errors(loop, runs, compiled)):
         if error is None:
             metas.append(None)
             continue
