@@ -420,8 +420,8 @@ def test_run_compiled_gives_the_steps_numbers_and_is_the_default_for_long_record
     np.testing.assert_allclose(OUT_c, OUT_vm, rtol=1e-12, atol=1e-15)
     chosen = []
     compiled_roll = base._compiled_roll
-    monkeypatch.setattr(base, "_compiled_roll", lambda step, required: chosen.append(required)
-                        or compiled_roll(step, required))
+    monkeypatch.setattr(base, "_compiled_roll", lambda step, required, history: chosen.append(required)
+                        or compiled_roll(step, required, history))
     monkeypatch.setattr(base, "COMPILE_FROM", 200)
     obs.run(Y, U)                      # 300 >= 200: compiled by default
     obs.run(Y[:100], U[:100])          # shorter: the virtual machine
@@ -435,3 +435,28 @@ def test_run_compiled_gives_the_steps_numbers_and_is_the_default_for_long_record
     with pytest.raises(CodegenError, match="no C compiler"):
         fresh.run(Y, U, compiled=True)
     assert fresh.run(Y, U)[0].shape == (N + 1, fresh.state.size)  # the default falls back to the virtual machine
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_run_keeping_only_the_final_state_gives_the_same_outputs_and_last_state(compiled):
+    """states="final": the outputs of the full run and its last state, S (1, n_s), on both paths (the C loop
+    writes no state history); an unknown choice is named."""
+    import numpy as np
+    from problems import double_integrator
+
+    from uvsym.codegen.compile import find_compiler
+    from uvsym.errors import ObserverError
+    from uvsym.observers.ukf import ukf
+
+    if compiled and find_compiler() is None:
+        pytest.skip("no C compiler")
+    obs = ukf(double_integrator(outputs=("pos",)), dt=0.1, Q=np.diag([1e-6, 1e-4]), R=1e-4, P0=np.eye(2))
+    N = 2500  # more than one of the virtual machine's chunks
+    Y, U = np.random.default_rng(3).normal(scale=0.01, size=(N, 1)), np.zeros((N, 1))
+    S, OUT = obs.run(Y, U, compiled=compiled)
+    last, outputs = obs.run(Y, U, compiled=compiled, states="final")
+    assert last.shape == (1, obs.state.size) and outputs.shape == OUT.shape
+    np.testing.assert_array_equal(outputs, OUT)
+    np.testing.assert_array_equal(last[0], S[-1])
+    with pytest.raises(ObserverError, match="states must be 'all' or 'final'"):
+        obs.run(Y, U, states="last")

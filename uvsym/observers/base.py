@@ -129,10 +129,13 @@ class Observer:
                                 f" expected {self.state.size} finite")
         return s0
 
-    def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False,
-            compiled: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False, compiled: bool | None = None,
+            states: str = "all") -> tuple[np.ndarray, np.ndarray]:
         """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out)).
 
+        states: ``"all"`` returns every state S (N + 1, n_s), from s0; ``"final"`` only the last one, S (1, n_s),
+        which spares the history's memory where the outputs are what is wanted (the LMS monitor's state holds
+        its weights and regressor window, 235 numbers a sample).
         missing_y: Y may hold NaN (an estimator that skips the update of such a sample, e.g. a
         Kalman filter); the initial state is then taken from the first complete measurement.
         compiled: the steps in a compiled C loop (:func:`uvsym.codegen.compile.compile_roll`, IEEE flags:
@@ -149,6 +152,8 @@ class Observer:
         if bad_y or not np.all(np.isfinite(U)):
             raise ObserverError(f"{self.name}: inputs U must be finite and measurements Y finite"
                                 + (" or NaN" if missing_y else ""))
+        if states not in ("all", "final"):
+            raise ObserverError(f"{self.name}: states must be 'all' or 'final', got {states!r}")
         p = self.parameters(p)
         first = next((k for k in range(len(Y)) if np.all(np.isfinite(Y[k]))), 0)
         s = self.initial_state(np.nan_to_num(Y[first]), U[0], p) if s0 is None else \
@@ -157,21 +162,25 @@ class Observer:
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
         roll = None
         if compiled or (compiled is None and len(Y) >= COMPILE_FROM and not missing_y):
-            roll = _compiled_roll(self.step, required=bool(compiled))
-        if roll is not None:  # one buffer of rows [out; s]: S and OUT are views of it, nothing copied
+            roll = _compiled_roll(self.step, required=bool(compiled), history=states == "all")
+        if roll is not None:
             W = np.ascontiguousarray(np.column_stack([Y, U, np.broadcast_to(p, (len(Y), p.size))]))
             n_out = self.publishes.size
-            rows = np.empty((len(Y) + 1, n_out + self.state.size))
+            if states == "final":
+                outputs = np.empty((len(Y), n_out))
+                return np.asarray(roll(s, W, outputs)).reshape(1, -1), outputs
+            rows = np.empty((len(Y) + 1, n_out + self.state.size))  # rows [out; s]: S and OUT views, no copy
             rows[0, :n_out], rows[0, n_out:] = np.nan, s
             roll(s, W, rows[1:])
             return rows[:, n_out:], rows[1:, :n_out]
-        states, outputs = [s[None, :]], []
+        kept, outputs = [s[None, :]], []
         for start in range(0, len(Y), RUN_CHUNK):  # fixed chunks: the cost is linear in N (one mapaccum(N) is not)
             k = min(RUN_CHUNK, len(Y) - start)
-            S, OUT = _rolled(self.step, k)(states[-1][-1], Y[start:start + k].T, U[start:start + k].T, p)
-            states.append(np.asarray(S).T.reshape(k, -1))
+            S, OUT = _rolled(self.step, k)(kept[-1][-1], Y[start:start + k].T, U[start:start + k].T, p)
+            S = np.asarray(S).T.reshape(k, -1)
+            kept.append(S if states == "all" else S[-1:])
             outputs.append(np.asarray(OUT).T.reshape(k, -1))
-        return np.vstack(states), np.vstack(outputs)
+        return np.vstack(kept) if states == "all" else kept[-1], np.vstack(outputs)
 
 
 RUN_CHUNK = 2048  # samples per mapaccum call of Observer.run
@@ -179,15 +188,16 @@ COMPILE_FROM = 5000  # samples from which Observer.run compiles its steps by def
 
 
 @memoized(32)
-def _compiled_roll(step: ca.Function, required: bool):
-    """``roll(s0, W, rows)`` of ``step`` in C (W's rows [y; u; p], each row of ``rows`` [out; s_next]); None
-    without a compiler unless ``required`` (then CodegenError)."""
+def _compiled_roll(step: ca.Function, required: bool, history: bool = True):
+    """``roll(s0, W, rows) -> s_end`` of ``step`` in C (W's rows [y; u; p], each row of ``rows`` [out; s_next],
+    or [out] without the state ``history``); None without a compiler unless ``required`` (then CodegenError)."""
     from uvsym.codegen.compile import DEFAULT_FLAGS, compile_roll
     from uvsym.errors import CodegenError
 
     s, y, u, p = (ca.SX.sym(name, step.size1_in(i)) for i, name in enumerate(STEP_INPUTS))
     s_next, out = step(s, y, u, p)
-    rolled = ca.Function(f"{step.name()}_run", [s, ca.vertcat(y, u, p)], [s_next, ca.vertcat(out, s_next)])
+    rows = ca.vertcat(out, s_next) if history else out
+    rolled = ca.Function(f"{step.name()}_run{'' if history else '_out'}", [s, ca.vertcat(y, u, p)], [s_next, rows])
     try:
         return compile_roll(rolled, DEFAULT_FLAGS)
     except CodegenError:

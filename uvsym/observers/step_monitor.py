@@ -256,7 +256,7 @@ def step_power(sizes, *, dt: float, false_alarms_per_hour: float = 0.1, before: 
     confirmed_column = monitor.publishes.names.index("confirmed_y")
     probability = []
     for size in sizes:
-        _, out = monitor.run((size * level + rng.standard_normal(n))[:, None], np.zeros((n, 0)))
+        _, out = monitor.run((size * level + rng.standard_normal(n))[:, None], np.zeros((n, 0)), states="final")
         hits = k[out[:, confirmed_column] > 0.5]
         probability.append(float(np.mean([np.any((hits >= onset) & (hits < onset + after + 1)) for onset in onsets])))
     return {"sizes": sizes, "probability": probability, "edges": edges}
