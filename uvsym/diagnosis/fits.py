@@ -100,10 +100,18 @@ class _Columns:
         return c, phi
 
 
-def _schur(S: np.ndarray, basis: np.ndarray, W: np.ndarray) -> np.ndarray:
-    """Gram matrix of the combinations W (size, q) after projecting out the combinations ``basis``."""
+def _schur(S: np.ndarray, basis: np.ndarray, W: np.ndarray, inverse: np.ndarray | None = None) -> np.ndarray:
+    """Gram matrix of the combinations W (size, q) after projecting out the combinations ``basis``; inverse:
+    the pseudo-inverse of ``basis' S basis`` where the caller has it (None: computed here)."""
     SB = S @ basis
-    return W.T @ S @ W - (W.T @ SB) @ np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True) @ (SB.T @ W)
+    if inverse is None:
+        inverse = _pinv(basis.T @ SB)
+    return W.T @ S @ W - (W.T @ SB) @ inverse @ (SB.T @ W)
+
+
+def _pinv(gram: np.ndarray) -> np.ndarray:
+    """The pseudo-inverse of a symmetric Gram matrix (singular values below 1e-12 of the largest dropped)."""
+    return np.linalg.pinv(gram, rcond=1e-12, hermitian=True)
 
 
 def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], values: np.ndarray,
@@ -118,9 +126,9 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     y = Z.unit(Z.n_t) - sum((c for c, _ in model_cols), np.zeros(Z.size))
     basis = np.column_stack([free] + [phi[:, None] for _, phi in model_cols])
     SB = Z.S @ basis
-    inverse = np.linalg.pinv(basis.T @ SB, rcond=1e-12, hermitian=True)
+    inverse = _pinv(basis.T @ SB)
     theta_model, cov_model = (inverse @ (SB.T @ y))[Z.n_t:], inverse[Z.n_t:, Z.n_t:]
-    J_model = float(_schur(Z.S, basis, y[:, None])[0, 0])
+    J_model = float(_schur(Z.S, basis, y[:, None], inverse)[0, 0])
     removal, power = np.zeros(len(model)), np.zeros(len(model))
     for i, (c, phi) in enumerate(model_cols):
         others = np.delete(basis, Z.n_t + i, axis=1)
@@ -131,7 +139,7 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     cols = [Z.hypothesis(h) for h in candidates]
     U = np.column_stack([y - c for c, _ in cols])  # each candidate's target
     X = np.column_stack([phi for _, phi in cols])
-    gram = _schur(Z.S, basis, np.hstack([U, X]))
+    gram = _schur(Z.S, basis, np.hstack([U, X]), inverse)
     H = len(candidates)
     uu, ux, xx = np.diagonal(gram[:H, :H]), np.diagonal(gram[:H, H:]), np.diagonal(gram[H:, H:])
     seen = xx > 1e-12 * max(float(np.max(xx)), 1e-300)
