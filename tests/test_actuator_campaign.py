@@ -107,3 +107,21 @@ def test_excitation_is_judged_from_the_command_after_the_onset():
     assert moving["excited"] and moving["command_variation"] == pytest.approx(0.0707 / 0.5236, rel=0.05)
     # a proportional fault on a command at zero has no effect to see
     assert not metrics(scenario, _Result(np.zeros(t.size), t), [])["excited"]
+
+
+def test_the_limits_compare_ten_hour_settings_with_the_designed_rate_and_name_the_short_ones():
+    """A setting of 10 fault-free hours or more is measured against the designed rate (a rate above it is
+    named); a shorter one is said to be too short, not compared."""
+    from derivations.actuator_observers.report import limits_section
+
+    figures = {"limits": {}, "designed_false_alarms_per_hour": 0.036, "decision_period_s": 0.1,
+               "window_false_alarm_rate": 1e-6, "campaign_false_alarms_before_onset": 0,
+               "fault_free": [{"noise": "none", "hours": 0.04, "false_alarms": 0, "per_hour": 0.0},
+                              {"noise": "told", "hours": 10.0, "false_alarms": 0, "per_hour": 0.0},
+                              {"noise": "told x2", "hours": 10.0, "false_alarms": 3, "per_hour": 0.3}]}
+    text = " ".join(limits_section(figures).split())
+    assert "at most 0.036 false alarms per hour" in text
+    assert "told: 0 in 10 h; told x2: 3 in 10 h; above the designed rate at told x2" in text
+    assert "too few fault-free hours to confirm that rate (none (0.04 h))" in text
+    figures["fault_free"][2] |= {"false_alarms": 0, "per_hour": 0.0}
+    assert "none above the designed rate" in " ".join(limits_section(figures).split())

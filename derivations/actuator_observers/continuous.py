@@ -49,6 +49,13 @@ def _noisy(faults) -> bool:
     return bool(faults) and faults != "[]"
 
 
+def _velocity_noise(row: dict) -> str:
+    """A run's velocity-noise setting: none, told (the noisy cases' levels) or told x2 (twice them)."""
+    if row["case"].endswith("noise x2"):
+        return "told x2"
+    return "told" if "sensor noise" in row["case"] or "10 h" in row["case"] or _noisy(row.get("faults")) else "none"
+
+
 def _decided(row: dict) -> str:
     if row["isolated_target"] is None:
         return "ambiguous" if row["ambiguous"] else "none"
@@ -85,8 +92,11 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
                                                    if _vehicle(c) == vehicle], size=fault_size)
               for vehicle in dict.fromkeys(_vehicle(r["case"]) for r in rows)}
     for row in rows:
-        row["velocity_noise"] = "told" if "sensor noise" in row["case"] or _noisy(row.get("faults")) else "none"
-    return {**figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
+        row["velocity_noise"] = _velocity_noise(row)
+    diagnosis = load_scenario("docking_diagnosis").diagnosis
+    return {"designed_false_alarms_per_hour": 3600.0 / diagnosis.period_s * diagnosis.false_alarm_rate,
+            "decision_period_s": diagnosis.period_s, "window_false_alarm_rate": diagnosis.false_alarm_rate,
+            **figures, "targets": targets(figures), "by_kind": by_kind, "wrong": wrong,
             "limits": limits, "fault_free": false_alarm_rates(rows, "velocity_noise"),
             "size_intervals": size_intervals(rows),
             "excluded": [{"vehicle": v, "actuator": a, "kind": k, "runs": n}
