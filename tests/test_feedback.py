@@ -50,6 +50,23 @@ def test_open_loop_table_drives_an_integrator(interpolation):
     np.testing.assert_allclose(result["x"]["q"], np.concatenate([[0.0], np.cumsum(u[:-1]) * DT]), atol=1e-12)
 
 
+@pytest.mark.parametrize("interpolation", ["previous", "linear"])
+def test_a_table_evaluated_on_a_numpy_time_vector_is_the_casadi_block_to_the_last_bit(interpolation):
+    """The disturbance schedules take the numpy path of the table's rule; the block steps take CasADi's."""
+    from uvsym.sim.feedback import table_value
+
+    times, values = np.array([0.3, 1.0, 2.5]), np.array([[1.0, 0.1], [-1.7, 0.2], [0.45, -3.0]])
+    table = open_loop("table", times, values, publishes=["a", "b"], interpolation=interpolation)
+    t = np.concatenate([np.linspace(0.0, 3.0, 301), times - 1e-9, times - 2e-9, times + 1e-12])
+    from_casadi = np.asarray(table.step.map(t.size)(np.zeros((0, t.size)), t[None, :])[1]).T
+    from_numpy = table_value(t, times, values, interpolation)
+    assert from_numpy.shape == (t.size, 2)
+    np.testing.assert_array_equal(from_numpy, from_casadi)
+    expected = np.column_stack([np.interp(t, times, values[:, j]) for j in range(2)]) if interpolation == "linear" \
+        else values[np.clip(np.searchsorted(times, t + 1e-9, side="right") - 1, 0, None)]
+    np.testing.assert_allclose(from_numpy, expected, rtol=0, atol=1e-12)
+
+
 def test_lqr_gain_of_a_double_integrator_is_the_closed_form():
     A, B = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [1.0]])
     # Q = I, R = 1: K = [1, sqrt(3)] (P = [[sqrt 3, 1], [1, sqrt 3]])

@@ -20,7 +20,7 @@ from uvsym.systems.discretize import zoh_matrices
 from uvsym.systems.signals import Signals, signals
 from uvsym.systems.system import System
 
-__all__ = ["pid", "state_feedback", "lqr", "lqr_gain", "open_loop", "INTERPOLATIONS"]
+__all__ = ["pid", "state_feedback", "lqr", "lqr_gain", "open_loop", "table_value", "INTERPOLATIONS"]
 
 INTERPOLATIONS = ("previous", "linear")
 
@@ -165,14 +165,28 @@ def open_loop(name: str, t_table, u_table, publishes: Sequence[str] | Signals,
                          f"table for {list(publishes.names)}; got {times.size} times and shape {np.shape(u_table)}")
 
     def step(s, r):
-        t, u = r[0], ca.DM(values[0])
-        for i in range(1, times.size):
-            if interpolation == "previous":
-                u = u + ca.if_else(t >= times[i] - 1e-9, 1.0, 0.0) * ca.DM(values[i] - values[i - 1])
-            else:
-                slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
-                u = u + (ca.fmin(ca.fmax(t, times[i - 1]), times[i]) - times[i - 1]) * ca.DM(slope)
-        return s, u
+        return s, table_value(r[0], times, values, interpolation)
 
     return block(name, step=step, reads=signals(("t", "s", "loop time"), group="read"), publishes=publishes,
                  description=f"time table ({interpolation})")
+
+
+def table_value(t, times: np.ndarray, values: np.ndarray, interpolation: str):
+    """u(t) of a time table (:func:`open_loop`'s rule): t a CasADi scalar -> (m,) CasADi column, or t a
+    numpy (N,) array of times (s) -> (N, m) array, by the same operations in the same order (so the
+    two agree to the last bit). times (k,) strictly increasing (s), values (k, m)."""
+    numeric = isinstance(t, np.ndarray)
+    if numeric:
+        t = t[:, None]
+        u, constant = np.broadcast_to(values[0], (t.shape[0], values.shape[1])), np.asarray
+        where, low, high = (lambda c: np.where(c, 1.0, 0.0)), np.fmax, np.fmin
+    else:
+        u, constant = ca.DM(values[0]), ca.DM
+        where, low, high = (lambda c: ca.if_else(c, 1.0, 0.0)), ca.fmax, ca.fmin
+    for i in range(1, times.size):
+        if interpolation == "previous":
+            u = u + where(t >= times[i] - 1e-9) * constant(values[i] - values[i - 1])
+        else:
+            slope = (values[i] - values[i - 1]) / (times[i] - times[i - 1])
+            u = u + (high(low(t, times[i - 1]), times[i]) - times[i - 1]) * constant(slope)
+    return u

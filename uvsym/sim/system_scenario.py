@@ -269,7 +269,7 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
 def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, step: float) -> np.ndarray:
     """The [[disturbances]] schedules (module docstring) over the samples ``k step``, k = 0..N: (N + 1,
     n_d) with the other disturbances at their constants d (n_d,); d itself without schedules."""
-    from uvsym.sim.feedback import INTERPOLATIONS, open_loop
+    from uvsym.sim.feedback import INTERPOLATIONS, open_loop, table_value
 
     if not items:
         return d
@@ -285,8 +285,8 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
         values = fields.vector("values", times.size)
         how = fields.text("interpolation", "previous", choices=INTERPOLATIONS)
         fields.done()
-        schedule_step = open_loop(f"disturbance_{signal}", times, values, (signal,), how).step  # a set-point's rule
-        table[:, plant.d.index(signal)] = np.asarray(schedule_step.map(N + 1)(np.zeros((0, N + 1)), t[None, :])[1])
+        open_loop(f"disturbance_{signal}", times, values, (signal,), how)  # its checks: a set-point's table
+        table[:, plant.d.index(signal)] = table_value(t, times, values.reshape(-1, 1), how)[:, 0]
     return table
 
 
