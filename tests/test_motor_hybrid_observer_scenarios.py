@@ -83,6 +83,22 @@ def test_campaign_figures_come_from_the_rows():
     assert f["overall"]["hybrid"]["detection_probability"] == 0.5
 
 
+def test_designed_false_alarm_rates_are_compared_only_over_ten_fault_free_hours():
+    from derivations.motor_hybrid_observer.campaign_text import designed_against_measured
+
+    rows = [_row("no fault, 10 h", None, 0.02, None, 4, duration=36000.0),
+            _row("no fault, 10 h", None, 0.04, None, 30, duration=36000.0),
+            _row("no fault", None, 0.06, None, 0, duration=360.0)]
+    f = figures(rows) | {"designed_false_alarms_per_hour": {"hybrid": 1.0, "hybrid_study": None,
+                                                             "luenberger_fd": 1.0}}
+    text = designed_against_measured(f)
+    assert "hybrid, z sigma at 1 /h (designed for 1 per hour): 0.02 rad/s: 0.4 (4 in 10 h); " \
+           "0.04 rad/s: 3 (30 in 10 h); above it at 0.04 rad/s" in text
+    assert "study's threshold (a given threshold: no designed rate)" in text
+    assert text.endswith("Too few fault-free hours to confirm a rate at 0.06 rad/s (0.1 h).")
+    assert f["other_runs"] == []  # healthy runs are not listed with the faulty ones
+
+
 @pytest.mark.parametrize("name", SHIPPED)
 def test_detection_times_are_the_studys(study, files, name):
     for observer, detector in DETECTOR.items():

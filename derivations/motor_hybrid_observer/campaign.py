@@ -20,12 +20,12 @@ from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_rates
 from uvsym.progress import ProgressBar
 
-__all__ = ["CAMPAIGN", "DETECTORS", "campaign_results", "figures"]
+__all__ = ["CAMPAIGN", "DETECTORS", "campaign_results", "designed_rates", "figures"]
 
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
 DETECTORS = ("hybrid", "hybrid_study", "luenberger_fd")
 STEP_CASE = "speed sensor step"
-HEALTHY_CASE = "no fault"
+HEALTHY_CASES = "no fault"  # the prefix of the healthy cases' names
 RATES = ("runs", "fault_runs", "detection_probability", "missed_detections", "median_detection_delay_s",
          "median_size_error_rel", "false_alarms", "healthy_hours", "false_alarms_per_hour")
 
@@ -50,6 +50,7 @@ def figures(rows: list[dict]) -> dict:
     ok = [r for r in rows if r["status"] == "ok"]
     cases = list(dict.fromkeys(r["case"] for r in rows))
     steps = [r for r in ok if r["case"] == STEP_CASE]
+    healthy = [r for r in ok if r["case"].startswith(HEALTHY_CASES)]
     sizes = sorted({r["true_value"] for r in steps})
     noises = sorted({r["noise.omega_m"] for r in steps})
     grid = {f"{noise:g}": {f"{size:g}": {d: next(r[f"{d}:detection_delay_s"] for r in steps
@@ -59,12 +60,12 @@ def figures(rows: list[dict]) -> dict:
                "noise_omega_m": r.get("noise.omega_m"), "duration_s": r["duration_s"],
                **{f"{d}:{k}": r[f"{d}:{k}"] for d in DETECTORS
                   for k in ("detection_delay_s", "identified_value", "false_alarms")}}
-              for r in ok if r["case"] != STEP_CASE]
+              for r in ok if r["case"] != STEP_CASE and not r["case"].startswith(HEALTHY_CASES)]
     return {"runs": len(rows), "errors": len(rows) - len(ok), "overall": _rates(ok),
             "cases": {case: _rates([r for r in ok if r["case"] == case]) for case in cases},
             "step_detection_delay_s": grid, "other_runs": others,
-            "healthy_by_noise": {f"{noise:g}": _rates([r for r in ok if r["case"] == HEALTHY_CASE
-                                                        and r["noise.omega_m"] == noise]) for noise in noises}}
+            "healthy_by_noise": {f"{noise:g}": _rates([r for r in healthy if r["noise.omega_m"] == noise])
+                                 for noise in sorted({r["noise.omega_m"] for r in healthy})}}
 
 
 def campaign_results(progress, workers: int | None = None) -> dict:
@@ -74,4 +75,14 @@ def campaign_results(progress, workers: int | None = None) -> dict:
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
         rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
                             progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
-    return figures(rows)
+    return figures(rows) | {"designed_false_alarms_per_hour": designed_rates(campaign)}
+
+
+def designed_rates(campaign) -> dict:
+    """Per detector, the false alarms per hour its rule is designed for under the stated noise (None for a
+    given threshold: a calibrated constant, no noise model behind it)."""
+    from uvsym.sim.system_scenario import parse_any_scenario
+
+    scenario = parse_any_scenario(campaign.runs[0].scenario)
+    return {d.name: d.design()["false_alarms_per_hour"] if "z sigma" in d.design()["rule"] else None
+            for d in scenario.detectors if d.name in DETECTORS}

@@ -17,6 +17,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from uvsym.codegen.cache import memoized
 from uvsym.errors import DiagnosisError
 
 __all__ = ["residual_covariance", "signal_rows"]
@@ -46,17 +47,19 @@ def residual_covariance(loop, z0: np.ndarray, w0: np.ndarray, names: tuple[str, 
     Raises DiagnosisError naming the signal for an unknown name, and when the sum does not settle
     (the loop linearised there is unstable in a mode the noise excites).
     """
-    rows = signal_rows(loop, names)
     n_y = loop.plant.y.size
-    z, w = ca.SX.sym("z", loop.n_z), ca.SX.sym("w", loop.n_w)
-    z_next, out = loop.step(z, w)
-    r = ca.vertcat(*[out[i] for i in rows])
-    noise = w[1:1 + n_y]
-    jac = ca.Function("linearised", [z, w], [ca.jacobian(z_next, z), ca.jacobian(z_next, noise),
-                                             ca.jacobian(r, z), ca.jacobian(r, noise)])
     point = np.array(w0, dtype=float)
     point[1:1 + n_y] = 0.0
-    A, B, C, D = (np.asarray(M, dtype=float) for M in jac(z0, point))
+    return _stationary(loop.step, tuple(signal_rows(loop, names)), n_y, np.asarray(z0, dtype=float), point,
+                       tuple(names)).copy()
+
+
+@memoized(64)
+def _stationary(step: ca.Function, rows: tuple[int, ...], n_y: int, z0: np.ndarray, point: np.ndarray,
+                names: tuple[str, ...]) -> np.ndarray:
+    """residual_covariance's sum (module docstring) at (z0, point); the runs of a campaign that share a loop
+    and its calibration point share it."""
+    A, B, C, D = (np.asarray(M, dtype=float) for M in _linearised(step, rows, n_y)(z0, point))
     S, A_j = B @ B.T, A
     previous = C @ S @ C.T + D @ D.T
     for _ in range(_DOUBLINGS):
@@ -72,3 +75,16 @@ def residual_covariance(loop, z0: np.ndarray, w0: np.ndarray, names: tuple[str, 
     raise DiagnosisError(f"the noise variance of {', '.join(names)} does not settle: the loop linearised at "
                          "the calibration point is unstable in a mode the sensor noise excites (stabilise the loop, "
                          "or state the residuals' standard deviations in the detector's std field)")
+
+
+@memoized(16)
+def _linearised(step: ca.Function, rows: tuple[int, ...], n_y: int) -> ca.Function:
+    """(z, w) -> (A, B, C, D) of the module docstring for the loop ``step`` (z, w) -> (z_next, out), the
+    residuals its ``out`` rows, the noise draws w[1:1 + n_y]; built once per loop (the runs of a campaign
+    share theirs)."""
+    z, w = ca.SX.sym("z", step.nnz_in(0)), ca.SX.sym("w", step.nnz_in(1))
+    z_next, out = step(z, w)
+    r = ca.vertcat(*[out[i] for i in rows])
+    noise = w[1:1 + n_y]
+    return ca.Function("linearised", [z, w], [ca.jacobian(z_next, z), ca.jacobian(z_next, noise),
+                                              ca.jacobian(r, z), ca.jacobian(r, noise)])

@@ -269,11 +269,11 @@ def _faults(items: list[Fields], plant: System, duration: float, noise: dict[str
 def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, step: float) -> np.ndarray:
     """The [[disturbances]] schedules (module docstring) over the samples ``k step``, k = 0..N: (N + 1,
     n_d) with the other disturbances at their constants d (n_d,); d itself without schedules."""
-    from uvsym.sim.feedback import INTERPOLATIONS, open_loop, table_value
+    from uvsym.sim.feedback import INTERPOLATIONS, open_loop
 
     if not items:
         return d
-    table, t = np.tile(d, (N + 1, 1)), step * np.arange(N + 1)
+    schedules = []
     for fields in items:
         fields.describe("signal", "string", "one of the plant's disturbances")
         signal = fields.text("signal", choices=plant.d.names)
@@ -286,7 +286,20 @@ def _disturbances(items: list[Fields], plant: System, d: np.ndarray, N: int, ste
         how = fields.text("interpolation", "previous", choices=INTERPOLATIONS)
         fields.done()
         open_loop(f"disturbance_{signal}", times, values, (signal,), how)  # its checks: a set-point's table
-        table[:, plant.d.index(signal)] = table_value(t, times, values.reshape(-1, 1), how)[:, 0]
+        schedules.append((plant.d.index(signal), times, values.reshape(-1, 1), how))
+    return _scheduled(d, tuple(schedules), N, step)
+
+
+@memoized(8)
+def _scheduled(d: np.ndarray, schedules: tuple, N: int, step: float) -> np.ndarray:
+    """(N + 1, n_d) read-only: the constants d with each schedule (column, times, values (k, 1), interpolation)
+    at the samples k step; shared by the runs of a campaign that schedule alike."""
+    from uvsym.sim.feedback import table_value
+
+    table, t = np.tile(d, (N + 1, 1)), step * np.arange(N + 1)
+    for column, times, values, how in schedules:
+        table[:, column] = table_value(t, times, values, how)[:, 0]
+    table.flags.writeable = False
     return table
 
 
