@@ -50,6 +50,32 @@ def test_every_example_runs(example, tmp_path, monkeypatch, capsys):
 
 
 
+def test_every_paper_page_includes_the_measured_limits_its_report_writes():
+    """Each docs/papers page shows its study's limits by including them from the committed report (numbers
+    the report's run computed, never typed into the page); the block holds no link a page could not resolve."""
+    from uvsym.report import LIMITS_MARKERS
+
+    pages = sorted(p for p in (ROOT / "docs" / "papers").glob("*.md") if p.name != "index.md")
+    assert len(pages) == len(PAPERS)
+    for page in pages:
+        included = re.findall(r"```\{include\} \.\./\.\./reports/([\w-]+)/report\.md\n:start-after: (.+)\n"
+                              r":end-before: (.+)\n```", page.read_text())
+        assert included and included[0][1:] == LIMITS_MARKERS, f"{page.name} does not include its report's limits"
+        report = (ROOT / "reports" / included[0][0] / "report.md").read_text()
+        assert report.count(LIMITS_MARKERS[0]) == 1 and report.count(LIMITS_MARKERS[1]) == 1, included[0][0]
+        block = report.split(LIMITS_MARKERS[0])[1].split(LIMITS_MARKERS[1])[0]
+        assert "](" not in block and "per hour" in block, f"{included[0][0]}: its limits block"
+
+
+def test_a_limits_block_refuses_a_link():
+    from uvsym.errors import FileFormatError
+    from uvsym.report import limits_block
+
+    assert limits_block("Smallest fault: 0.2.\n").startswith("<!-- limits -->\n\nSmallest fault: 0.2.\n\n")
+    with pytest.raises(FileFormatError, match="no links"):
+        limits_block("see [the table](campaign.md)")
+
+
 def test_the_api_page_sorts_every_top_level_module_by_subject():
     page = (ROOT / "docs" / "api.md").read_text()
     listed = re.findall(r"^   (uvsym\.\w+)$", page[page.index("## By subject"):], re.M)

@@ -211,9 +211,7 @@ def limits_section(f: dict) -> str:
     measured = "; ".join(f"{r['noise']}: {r['false_alarms']} in {r['hours']:.3g} h" for r in long_enough)
     verdict = (f"above the designed rate at {', '.join(str(r['noise']) for r in above)}" if above else
                "none above the designed rate")
-    return f"""### Limits (from the campaign)
-
-Fault sizes are a proportional fault's distance from a factor of 1 and a bias's magnitude (N, rpm or rad);
+    return "### Limits (from the campaign)\n\n" + limits_block(f"""Fault sizes are a proportional fault's distance from a factor of 1 and a bias's magnitude (N, rpm or rad);
 a stuck actuator's value is no size (what it hides depends on the commands), so stuck faults are left
 out here. Each size was tried in a handful of runs (two onsets, with and without noise), so "detected in
 every run from" brackets the smallest detectable fault between the sizes tried; the campaign does not
@@ -235,7 +233,7 @@ over the hypotheses), and a confirmed alarm needs at least one such window, so a
 What the diagnosis cannot see, by construction: a fault of an actuator
 whose command stays put after the onset (proportional, bias and stuck faults then act alike: the
 unexcited runs above), a proportional fault while its command is near zero, and a fault on an actuator
-whose column of B is parallel to another's (no measurement tells the two apart: ambiguous)."""
+whose column of B is parallel to another's (no measurement tells the two apart: ambiguous).""")
 
 
 def _short_settings(short: list[dict]) -> str:

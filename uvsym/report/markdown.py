@@ -9,7 +9,9 @@ import numpy as np
 
 from uvsym.errors import FileFormatError
 
-__all__ = ["markdown_table", "latex_matrix", "write_json"]
+__all__ = ["markdown_table", "latex_matrix", "write_json", "limits_block", "LIMITS_MARKERS"]
+
+LIMITS_MARKERS = ("<!-- limits -->", "<!-- /limits -->")  # a doc page includes the text between them
 
 
 def markdown_table(header: list[str], rows: list[list]) -> str:
@@ -19,6 +21,15 @@ def markdown_table(header: list[str], rows: list[list]) -> str:
     lines = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(cell(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def limits_block(body: str) -> str:
+    """A study's measured limits (Markdown without links or images: a doc page includes it from the report,
+    between the two LIMITS_MARKERS, with MyST's ``{include}``)."""
+    if "](" in body:
+        raise FileFormatError("a limits block holds no links or images: the doc page that includes it resolves them "
+                         "from its own folder")
+    return f"{LIMITS_MARKERS[0]}\n\n{body.strip()}\n\n{LIMITS_MARKERS[1]}"
 
 
 def latex_matrix(matrix, digits: int = 6) -> str:
