@@ -7,7 +7,7 @@ import casadi as ca
 from derivations.actuator_observers.paper import DOCK_RADIUS_M, PAPER, ROUNDING_SHOWN_AS_ZERO, TARGETS
 from derivations.papers import paper
 from uvsym.campaign.limits import false_alarm_table, limits_table
-from uvsym.report import markdown_table
+from uvsym.report import limits_block, markdown_table
 from uvsym.report.sections import c_section, claims_table, counterexamples
 from uvsym.sim.scenario import Scenario
 from uvsym.sim.simulation import scenario_observers
@@ -211,7 +211,8 @@ def limits_section(f: dict) -> str:
     measured = "; ".join(f"{r['noise']}: {r['false_alarms']} in {r['hours']:.3g} h" for r in long_enough)
     verdict = (f"above the designed rate at {', '.join(str(r['noise']) for r in above)}" if above else
                "none above the designed rate")
-    return "### Limits (from the campaign)\n\n" + limits_block(f"""Fault sizes are a proportional fault's distance from a factor of 1 and a bias's magnitude (N, rpm or rad);
+    return "### Limits (from the campaign)\n\n" + limits_block(f"""
+Fault sizes are a proportional fault's distance from a factor of 1 and a bias's magnitude (N, rpm or rad);
 a stuck actuator's value is no size (what it hides depends on the commands), so stuck faults are left
 out here. Each size was tried in a handful of runs (two onsets, with and without noise), so "detected in
 every run from" brackets the smallest detectable fault between the sizes tried; the campaign does not
