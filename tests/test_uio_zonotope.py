@@ -27,3 +27,13 @@ def test_angle_only_set_up_fails_at_the_sampling_zero():
     with pytest.raises(UIOConditionError) as info:
         uio_conditions(G, np.eye(6)[:3], D1)
     assert any(abs(v + 1) < 1e-6 for v in info.value.eigenvalues)
+
+
+def test_a_yaw_torque_made_by_the_four_rotors_together_is_invisible_to_every_observer():
+    """The limits' "front and back rotors up, right and left down": that input acts along D1, which every
+    observer decouples."""
+    plant, _, H, D1 = sampled()
+    assert plant.u.names == ("Vf", "Vb", "Vr", "Vl")
+    torque = H @ np.array([1.0, 1.0, -1.0, -1.0])
+    along = D1 @ np.linalg.lstsq(D1, torque, rcond=None)[0]
+    assert np.linalg.norm(torque) > 1e-4 and np.linalg.norm(torque - along) < 1e-12 * np.linalg.norm(torque)

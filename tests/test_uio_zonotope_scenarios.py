@@ -254,3 +254,68 @@ def test_uvsym_simulate_prints_the_bank_decisions_and_writes_the_log(tmp_path, c
     log = json.loads((tmp_path / "events.json").read_text())
     assert [(e["event"], e["target"], e["detector"]) for e in log] == [("detected", None, "bands"),
                                                                        ("isolated", "Vf", "bands")]
+
+
+def _figures(runs: int, fault_runs: int | None = None, **given) -> dict:
+    """A group's figures as campaign_results gives them (None where the group has no such figure)."""
+    keys = ("detection_probability", "correct_isolation", "ambiguous", "unexplained", "wrong_isolation",
+            "median_detection_delay_s", "false_alarms_per_hour", "healthy_runs_alarmed", "median_first_false_alarm_s")
+    return {"runs": runs, "fault_runs": runs if fault_runs is None else fault_runs, "false_alarms": 0,
+            "healthy_hours": 0.01, **dict.fromkeys(keys), **given}
+
+
+def test_the_limits_block_states_the_campaign_figures():
+    """Built from fabricated figures: the smallest faults per rotor, the delays, the false alarms within and beyond
+    the bound beside the proved guarantee, what the bank cannot see; one marked block without a link."""
+    from derivations.uio_zonotope.campaign import limits_section
+    from uvsym.report import LIMITS_MARKERS
+
+    def healthy(runs, alarms, hours, alarmed, first):
+        return _figures(runs, 0, false_alarms=alarms, healthy_hours=hours, false_alarms_per_hour=alarms / hours,
+                        healthy_runs_alarmed=alarmed, median_first_false_alarm_s=first)
+
+    c = {"by_case_and_noise": {
+            "abrupt|1": _figures(16, wrong_isolation=0.125),
+            "no fault|1": healthy(3, 0, 6.0, 0.0, None),
+            "no fault, noise beyond the bound|2": healthy(4, 4, 2.0, 1.0, 0.01),
+            "no fault, noise beyond the bound|3": healthy(4, 6, 2.0, 0.75, 0.02),
+            "abrupt, noise beyond the bound|2": _figures(8, detection_probability=0.25),
+            "nonlinear plant, abrupt|1": _figures(12, detection_probability=0.5, correct_isolation=0.25,
+                                                  ambiguous=0.125, unexplained=0.375),
+            "nonlinear plant, no fault|1": healthy(1, 0, 0.05, 0.0, None)},
+         "abrupt_by_size": {"0.5": _figures(8, detection_probability=0.0, correct_isolation=0.0, ambiguous=0.0),
+                            "3": _figures(8, detection_probability=1.0, correct_isolation=0.0, ambiguous=1.0,
+                                          median_detection_delay_s=0.2),
+                            "10": _figures(8, detection_probability=1.0, correct_isolation=1.0, ambiguous=0.0,
+                                           median_detection_delay_s=0.01)},
+         "drift_by_rate": {"1": _figures(8, detection_probability=0.5, median_detection_delay_s=0.9),
+                           "4": _figures(8, detection_probability=1.0, median_detection_delay_s=0.3)},
+         "limits": {"abrupt": [{"channel": "Vf", "kind": "bias", "sizes": [(0.5, 2, 0), (3.0, 2, 2), (10.0, 2, 2)],
+                                "seen_from": 3.0, "missed_up_to": 0.5, "median_delay_s": 0.05}],
+                    "drift": [{"channel": "Vf", "kind": "bias", "sizes": [(1.0, 2, 1), (4.0, 2, 2)],
+                               "seen_from": 4.0, "missed_up_to": 1.0, "median_delay_s": 0.4}]}}
+    text = limits_section(c, 3, 4)
+    head, block = text.split(LIMITS_MARKERS[0])
+    assert head.startswith("### Limits") and text.count(LIMITS_MARKERS[1]) == 1 and text.endswith(LIMITS_MARKERS[1])
+    assert "](" not in block and "\n#" not in block
+    flat = " ".join(block.split())  # the text's line breaks fall anywhere
+    assert "tried in 2 runs per rotor" in flat
+    assert "| Vf | bias | 0.5: 0/2, 3: 2/2, 10: 2/2 | 3 V | 0.5 V | 0.05 |" in flat  # the abrupt limits' row
+    assert "from 0.2 s at 3 V to 0.01 s at 10 V (abrupt) and from 0.3 s at 4 V/s" in flat
+    assert "| no fault | 1 | 3 | 6 | 0 | 0 | 0 | - |" in flat
+    assert "prove it for 3 of 4 observers" in flat
+    assert "0 false alarms in 6 h, as proved" in flat and "below 0.5 per hour" in flat  # ln 20 / 6 h
+    assert "0.05 h are too few" in flat
+    assert "at 2 times it every fault-free run alarms once, first at 0.01 s (median), and faults are detected in " \
+           "their window with probability 0.25" in flat and "counts runs, not hours" in flat
+    assert "at 3 times it a fraction 0.75 of the fault-free runs alarm, first at 0.02 s" in flat
+    assert "Abrupt faults up to 0.5 V and drifts up to 1 V/s are missed" in flat
+    assert "below 10 V" in flat and "a fraction 1 end ambiguous" in flat  # the 3 V runs: all detected, ambiguous
+    assert "named in 2 of 16 fault runs" in flat
+    assert "12 abrupt faults are detected with probability 0.5, isolated correctly in a fraction 0.25" in flat
+
+def test_the_limits_block_says_when_the_designed_noise_gave_false_alarms():
+    from derivations.uio_zonotope.campaign import _designed_rate
+
+    assert "**not the 0 proved**" in _designed_rate(_figures(3, 0, false_alarms=2, healthy_hours=4.0,
+                                                             false_alarms_per_hour=0.5))

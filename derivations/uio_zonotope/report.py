@@ -115,8 +115,9 @@ def build(out_dir: Path, progress) -> None:
     results["campaign"] = study_campaign.campaign_results(out_dir, progress)
     results["scenario_events"] = _scenario_events()
     write_json(out_dir / "results.json", results)
-    (out_dir / "report.md").write_text(_report(results) + "\n" + study_campaign.section(results["campaign"],
-                                                                                       results["scenario_events"]))
+    campaign = study_campaign.section(results["campaign"], results["scenario_events"], results["bands_proved"],
+                                      results["isolation_actuators"])
+    (out_dir / "report.md").write_text(_report(results) + "\n" + campaign)
 
 
 def _scenario_events() -> dict:
