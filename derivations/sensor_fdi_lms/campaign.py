@@ -4,7 +4,9 @@ Runs the file through :func:`uvsym.campaign.run_campaign` (as ``uvsym campaign``
 its rows per detector (:func:`uvsym.campaign.summary.detector_rates`): detection probability, missed
 detections, median detection delay (s after the onset), correct isolation, false alarms and false
 alarms per hour, overall and per case; and, for the bias steps, the detections per size and noise
-level, and for the long healthy runs per noise level. Run times are left out (they differ from build to build).
+level and each detector's limits per noise level (:func:`uvsym.campaign.limits.channel_limits`), for the
+long healthy runs per noise level, the pulses per length, and the false alarms per hour each detector is
+designed for. Run times are left out (they differ from build to build).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import tempfile
 from pathlib import Path
 
 from uvsym.campaign import load_campaign, run_campaign
+from uvsym.campaign.limits import channel_limits
 from uvsym.campaign.summary import detector_rates
 from uvsym.progress import ProgressBar
 
@@ -41,6 +44,10 @@ def _noise_deg(row: dict) -> float:
     return round(math.degrees(row.get("noise.psi") or NOMINAL_NOISE), 6)
 
 
+def _size_deg(row: dict) -> float:
+    return round(math.degrees(abs(row["true_value"])), 6)
+
+
 def _healthy_by_noise(rows: list[dict]) -> list[dict]:
     """The long healthy runs: per compass noise (deg), the figures of every detector."""
     healthy = [r for r in rows if r["case"] == HEALTHY_CASE]
@@ -53,11 +60,29 @@ def _by_size(rows: list[dict]) -> list[dict]:
     groups: dict[tuple[float, float], list[dict]] = {}
     for row in rows:
         if row["case"] == BIAS_CASE and row["status"] == "ok":
-            groups.setdefault((round(math.degrees(row["true_value"]), 6), _noise_deg(row)), []).append(row)
+            groups.setdefault((_size_deg(row), _noise_deg(row)), []).append(row)
     return [{"size_deg": size, "noise_deg": noise, "runs": len(members),
              **{d: {"detected": sum(bool(r[f"{d}:detected"]) for r in members),
                     "false_alarms": sum(r[f"{d}:false_alarms"] or 0 for r in members)} for d in DETECTORS}}
             for (size, noise), members in sorted(groups.items())]
+
+
+def _bias_limits(rows: list[dict]) -> list[dict]:
+    """Bias steps per compass noise (deg): each detector's :func:`channel_limits` (sizes in deg)."""
+    steps = [r for r in rows if r["case"] == BIAS_CASE]
+    return [{"noise_deg": noise,
+             **{d: channel_limits([r for r in steps if _noise_deg(r) == noise], d, size=_size_deg) for d in DETECTORS}}
+            for noise in sorted({_noise_deg(r) for r in steps})]
+
+
+def _designed_rates(scenario: dict) -> dict:
+    """Per detector, the false alarms per hour it is designed for: its own ``false_alarms_per_hour`` or its
+    monitor block's (None: not designed)."""
+    blocks = {b["name"]: b for b in scenario["blocks"]}
+    detectors = {d["name"]: d for d in scenario["detectors"]}
+    return {d: detectors[d].get("false_alarms_per_hour",
+                                blocks.get(detectors[d].get("monitor"), {}).get("false_alarms_per_hour"))
+            for d in DETECTORS}
 
 
 def _pulses(rows: list[dict]) -> list[dict]:
@@ -87,7 +112,9 @@ def campaign_results(out_dir: Path, progress, workers: int | None = None) -> dic
     return {"runs": len(rows), "errors": errors,
             "simulated_hours": sum(r["duration_s"] or 0.0 for r in rows) / 3600.0,
             "detectors": _figures(rows), "cases": {case: _figures(members) for case, members in cases.items()},
-            "bias_by_size": _by_size(rows), "healthy_by_noise": _healthy_by_noise(rows), "pulses": _pulses(rows)}
+            "bias_by_size": _by_size(rows), "bias_limits": _bias_limits(rows),
+            "healthy_by_noise": _healthy_by_noise(rows), "pulses": _pulses(rows),
+            "designed_per_hour": _designed_rates(campaign.runs[0].scenario)}
 
 
 def _write_table(rows: list[dict], path: Path) -> None:
