@@ -99,6 +99,40 @@ def test_designed_false_alarm_rates_are_compared_only_over_ten_fault_free_hours(
     assert f["other_runs"] == []  # healthy runs are not listed with the faulty ones
 
 
+def test_the_limits_block_states_the_runs_figures():
+    from derivations.motor_hybrid_observer.campaign_text import limits_section
+    from uvsym.report import LIMITS_MARKERS
+
+    ramp = _row("speed sensor profiles", 0.5, 0.02, None, 0) | {"faults[0].profile": "ramp"}
+    rows = [_row(STEP_CASE, 0.1, 0.02, None, 0), _row(STEP_CASE, 0.2, 0.02, 0.003, 0),
+            _row(STEP_CASE, 0.5, 0.02, 0.001, 0),
+            _row(STEP_CASE, 0.1, 0.04, 0.002, 0), _row(STEP_CASE, 0.2, 0.04, None, 0),  # 0.1 seen, 0.2 missed
+            _row(STEP_CASE, 0.5, 0.04, 0.001, 0), ramp,
+            _row("no fault, 10 h", None, 0.02, None, 4, duration=36000.0),
+            _row("no fault", None, 0.04, None, 0, duration=360.0)]
+    campaign = figures(rows) | {"designed_false_alarms_per_hour": {"hybrid": 1.0, "hybrid_study": None,
+                                                                    "luenberger_fd": 1.0}}
+    variant = {"fault": 1.0, "load_step": 0.0, "load": 10.0, "rr_rise": 1.0, "noise_factor": 2.0, "ratio": 0.97,
+               "detected_at": 1.0, "unexplained_at": None}
+    loaded = {"variants": {"faulty": variant, "noise x1": variant | {"noise_factor": 1.0, "ratio": 0.99},
+                           "unknown load": variant | {
+        "fault": 0.0, "load_step": 4.0, "ratio": None, "detected_at": None, "unexplained_at": 3.5}},
+        "healthy_hours": 0.01, "healthy_false_alarms": 0}
+    text = limits_section({"campaign": campaign, "torque_balance": loaded, "loaded_identifiability": {
+        "load_N_m": 10.0, "operating_point": [0.0] * 5,
+        "1": {"speed_change_rad_per_s": -3.0, "currents_change_A": 1e-14, "mimicking_offset_rad_per_s": 1.5}}})
+    block = text.split(LIMITS_MARKERS[0])[1].split(LIMITS_MARKERS[1])[0]
+    assert text.count(LIMITS_MARKERS[0]) == 1 and "](" not in block
+    words = " ".join(block.split())
+    assert "| 0.02 (the study's) | 0.2 (3.0 ms) |" in words and "| 0.04 (2 x) | 0.5 (1.0 ms) |" in words
+    assert "| 0.02 (the study's) | 0.4 (4 in 10 h) |" in words and "0.04 rad/s (0.1 h)" in words
+    assert "The hybrid detector misses omega_m bias ramp 0.5; it sees none." in words
+    assert "offset f_s = 1.5000 rad/s" in words
+    assert "reach 97.00-99.00 % of the fault (2 runs, noise up to 2 x)" in words
+    assert "(4 N m) it cannot explain: it withdraws the estimate (at 3.5000 s)" in words
+    assert "raises no detection" in words
+
+
 @pytest.mark.parametrize("name", SHIPPED)
 def test_detection_times_are_the_studys(study, files, name):
     for observer, detector in DETECTOR.items():

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from derivations.motor_hybrid_observer.campaign_text import campaign_section
+from derivations.motor_hybrid_observer.campaign_text import campaign_section, limits_section
 from derivations.motor_hybrid_observer.claims import OVERSHOOT
 from derivations.motor_hybrid_observer.design import (
     BASELINE_DECAY,
@@ -291,6 +291,8 @@ the noise level.
 {_torque_balance(r["torque_balance"])}
 
 {campaign_section(r["campaign"])}
+{limits_section(r)}
+
 ## Generated C
 
 {c_section(r["c"], "The four observers' steps (detection, estimator, baseline, corrected)")}
