@@ -108,3 +108,62 @@ def test_nees_of_the_no_fault_ukf_on_healthy_runs_is_within_its_chi_square_bound
     low, high = chi2.ppf([0.005, 0.995], runs * 6) / runs
     assert np.mean((average > low) & (average < high)) >= 0.9
     assert abs(average.mean() / 6 - 1) < 0.15
+
+
+def test_the_limits_block_states_the_campaigns_figures():
+    """The limits block from fabricated campaign figures: a shipped rule (no designed rate) and an evidence rule
+    (1 /h designed) over one loss size missed and one detected, three noise levels, a loss that ends, two losses."""
+    from derivations.usv_fukf_mmae.campaign import ENDING, NOISIER, STEP, STUCK, _loss_percent, limits_section
+    from uvsym.report import LIMITS_MARKERS
+
+    assert _loss_percent({"true_kind": "proportional", "true_value": 0.9}) == 10.0
+    assert _loss_percent({"true_kind": "constant", "true_value": 80.0}) is None
+
+    def alarms(count, hours):
+        return {"false_alarms": count, "healthy_hours": hours, "false_alarms_per_hour": count / hours}
+
+    def ended(thruster, return_s):
+        return {"thruster": thruster, "value": 0.95, "detected": True, "return_s": return_s}
+
+    c = {"detectors": {"shipped": {"detection_probability": 1.0, "median_detection_delay_s": 0.4},
+                       "evidence": {"detection_probability": 0.5, "median_detection_delay_s": 1.9}},
+         "designed_false_alarms_per_hour": {"shipped": None, "evidence": 1.0},
+         "limits": {"shipped": [{"channel": "T_L", "kind": "proportional", "sizes": [(2.0, 1, 0), (5.0, 2, 2)],
+                                 "seen_from": 5.0, "missed_up_to": 2.0, "median_delay_s": 0.7}],
+                    "evidence": [{"channel": "T_L", "kind": "proportional", "sizes": [(2.0, 1, 0), (5.0, 2, 1)],
+                                  "seen_from": None, "missed_up_to": 5.0, "median_delay_s": 1.9}]},
+         "healthy_by_noise": {"1x": {"shipped": alarms(0, 10.0), "evidence": alarms(0, 10.0)},
+                              "3x": {"shipped": alarms(40, 2.0), "evidence": alarms(3, 2.0)},
+                              "3x, banks told": {"shipped": alarms(0, 0.1), "evidence": alarms(0, 0.1)}},
+         "returns": {"shipped": {"runs": [ended("T_L", None), ended("T_R", 0.1)], "never": 1, "largest_s": None,
+                                 "largest_finite_s": 0.1},
+                     "evidence": {"runs": [ended("T_L", 2.0), ended("T_R", 0.0)], "never": 0, "largest_s": 2.0,
+                                  "largest_finite_s": 2.0}},
+         "two_faults": [{"left": "T_L", "left_value": 0.5, "left_onset_s": 40.0, "right_value": 0.5,
+                         "right_onset_s": 40.0, "outcomes": {"shipped": "T_R", "evidence": "unexplained"}}],
+         "cases": {NOISIER: {"shipped": {"detection_probability": 1.0, "fault_runs": 2, "unexplained_runs": 0},
+                             "evidence": {"detection_probability": 0.0, "fault_runs": 2, "unexplained_runs": 2}}},
+         "failures": [{"case": STUCK, "thruster": "T_L", "kind": "constant", "value": 80.0, "noise": "1x",
+                       "problem": "isolated T_R at the end", "detectors": ["shipped"]},
+                      {"case": STEP, "thruster": "T_L", "kind": "proportional", "value": 0.98, "noise": "1x",
+                       "problem": "missed", "detectors": ["evidence"]}]}
+    block = limits_section(c)
+    assert block.startswith(LIMITS_MARKERS[0]) and block.endswith(LIMITS_MARKERS[1]) and "](" not in block
+    assert "False alarms per hour" in block
+    assert "| shipped | T_L | 2: 0/1, 5: 2/2 | 5 % | 2 % | 0.7 |" in block
+    assert "| evidence | T_L | 2: 0/1, 5: 1/2 | - | 5 % | 1.9 |" in block
+    assert f"cases\n`{STEP}` and `{ENDING}`" in block
+    assert "shipped: 1 / 0.4 s; evidence: 0.5 / 1.9 s." in block
+    assert "| designed | none (a posterior threshold) | at most 1 /h |" in block
+    assert "| 3x | 40 in 2 h: 20 /h | 3 in 2 h: 1.5 /h |" in block
+    assert "| 3x, banks told | 0 in 0.1 h: 0 /h (< 30 /h, 95 %) |" in block
+    assert "Measured above the designed rate: evidence: 3x (1.5 /h)." in block
+    assert "confirm the designed rate at\n95 %: evidence: 3x, banks told (0.1 h)." in block
+    assert "No rate is designed into shipped:" in block
+    assert "| shipped | never in 1 run(s), else up to 0.1 s | **missed** | 0 of 1 | **missed** |" in block
+    assert "| evidence | 2.00 s | met | 1 of 1 | met |" in block
+    assert "or to the end of the run: shipped: T_L 5 %." in block
+    assert "as well): evidence: T_R 5 %." in block
+    assert "detection probability shipped: 1; evidence: 0;" in block
+    assert "no culprit named) in evidence: 2 of 2 runs;" in block
+    assert "T_L stuck at 80 N: isolated T_R at the end (shipped); the" in block and "missed (evidence)" not in block

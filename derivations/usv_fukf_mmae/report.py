@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from derivations.usv_fukf_mmae import analysis as A
-from derivations.usv_fukf_mmae.campaign import campaign_section, run_study_campaign
+from derivations.usv_fukf_mmae.campaign import campaign_section, limits_section, run_study_campaign
 from derivations.usv_fukf_mmae.experiment import disturbed_plant, run
 from derivations.usv_fukf_mmae.figures import FIGURES, draw_all
 from derivations.usv_fukf_mmae.observer_sets import usv_fukf_mmae
@@ -285,6 +285,10 @@ becomes the decision; a thruster's hypothesis gives `detected` and `isolated` on
 {markdown_table(["t (s)", "detector", "event", "target", "kind", "value"], events)}
 
 {campaign_section(r["campaign"])}
+## Limits (measured by this report's campaign)
+
+{limits_section(r["campaign"])}
+
 ## Figures
 
 {figures}
