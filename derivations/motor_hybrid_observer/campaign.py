@@ -20,9 +20,11 @@ from uvsym.campaign import load_campaign, run_campaign
 from uvsym.campaign.summary import detector_rates
 from uvsym.progress import ProgressBar
 
-__all__ = ["CAMPAIGN", "DETECTORS", "campaign_results", "designed_rates", "figures"]
+__all__ = ["CAMPAIGN", "DETECTORS", "TORQUE_BALANCE_CAMPAIGN", "campaign_results", "designed_rates", "figures",
+           "torque_balance_healthy"]
 
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
+TORQUE_BALANCE_CAMPAIGN = Path(__file__).with_name("campaign_torque_balance.toml")
 DETECTORS = ("hybrid", "hybrid_study", "luenberger_fd")
 STEP_CASE = "speed sensor step"
 HEALTHY_CASES = "no fault"  # the prefix of the healthy cases' names
@@ -68,14 +70,34 @@ def figures(rows: list[dict]) -> dict:
                                  for noise in sorted({r["noise.omega_m"] for r in healthy})}}
 
 
-def campaign_results(progress, workers: int | None = None) -> dict:
-    """Run the campaign in a scratch folder (local processes) and return its :func:`figures`."""
-    campaign = load_campaign(CAMPAIGN)
-    progress(f"fault campaign: {len(campaign.runs)} runs of {CAMPAIGN.name}")
+def _rows(campaign, what: str, progress, workers: int | None) -> list[dict]:
+    """The result rows of ``campaign``, run in a scratch folder (local processes)."""
+    progress(f"{what}: {len(campaign.runs)} runs of {campaign.path.name}")
     with tempfile.TemporaryDirectory(prefix="uvsym-campaign-") as scratch:
-        rows = run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
+        return run_campaign(campaign, Path(scratch) / "campaign", executor="local", workers=workers,
                             progress=ProgressBar(f"  {campaign.name}", unit="runs")).to_pylist()
-    return figures(rows) | {"designed_false_alarms_per_hour": designed_rates(campaign)}
+
+
+def campaign_results(progress, workers: int | None = None) -> dict:
+    """Run the campaign and return its :func:`figures`."""
+    campaign = load_campaign(CAMPAIGN)
+    return figures(_rows(campaign, "fault campaign", progress, workers)) | {
+        "designed_false_alarms_per_hour": designed_rates(campaign)}
+
+
+def torque_balance_healthy(progress, workers: int | None = None) -> dict:
+    """The torque-balance estimator's long healthy runs (``campaign_torque_balance.toml``), per speed-sensor
+    noise (rad/s): runs, judged hours, false alarms (a detection or an unexplained torque) and their rate;
+    ``errors``: runs that ended in an error."""
+    rows = _rows(load_campaign(TORQUE_BALANCE_CAMPAIGN), "torque balance, long healthy runs", progress, workers)
+    ok = [r for r in rows if r["status"] == "ok"]
+    levels = {}
+    for noise in sorted({r["noise.omega_m"] for r in ok}):
+        group = [r for r in ok if r["noise.omega_m"] == noise]
+        hours, alarms = sum(r["tb_judged_s"] for r in group) / 3600.0, sum(r["tb_false_alarms"] for r in group)
+        levels[f"{noise:g}"] = {"runs": len(group), "hours": hours, "false_alarms": alarms,
+                                "per_hour": alarms / hours}
+    return {"levels": levels, "errors": len(rows) - len(ok)}
 
 
 def designed_rates(campaign) -> dict:

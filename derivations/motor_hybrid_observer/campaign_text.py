@@ -4,10 +4,11 @@ campaign's rows (:mod:`derivations.motor_hybrid_observer.campaign`) and the load
 from __future__ import annotations
 
 from derivations.motor_hybrid_observer.campaign import DETECTORS, STEP_CASE
+from derivations.motor_hybrid_observer.torque_balance import START_UNTIL
 from derivations.motor_luenberger.experiment import NOISE
 from uvsym.report import limits_block, markdown_table
 
-__all__ = ["campaign_section", "designed_against_measured", "limits_section"]
+__all__ = ["campaign_section", "designed_against_measured", "long_healthy", "limits_section"]
 
 WHO = {"hybrid": "hybrid, z sigma at 1 /h", "hybrid_study": "hybrid, study's threshold",
        "luenberger_fd": "Luenberger, z sigma at 1 /h"}
@@ -115,6 +116,22 @@ The limits these runs measure (with the loaded runs above) follow in the next se
 """
 
 
+def long_healthy(tb: dict) -> str:
+    """The torque-balance estimator's false alarms per hour in its long healthy runs beside its designed rate."""
+    levels, designed = tb["long_healthy"]["levels"], tb["false_alarms_per_hour_designed"]
+    measured = "; ".join(f"{noise} rad/s: {v['false_alarms']} in {v['hours']:.3g} h ({v['per_hour']:.3g} per hour)"
+                         for noise, v in levels.items())
+    above = [noise for noise, v in levels.items() if v["hours"] >= 10.0 and v["per_hour"] > designed]
+    short = [noise for noise, v in levels.items() if v["hours"] < 10.0]
+    verdict = (f"above the designed {designed:g} per hour at {', '.join(above)} rad/s" if above
+               else f"none above the designed {designed:g} per hour")
+    return (f"In its long healthy runs (`campaign_torque_balance.toml`: 20 N m, Rr +100 % over the first 10 s, "
+            f"runs of 30 s judged from {START_UNTIL:g} s), by "
+            f"speed-sensor noise: {measured}; {verdict}"
+            + (f" (too few hours to confirm it at {', '.join(short)} rad/s)" if short else "")
+            + (f"; {tb['long_healthy']['errors']} runs ended in an error" if tb["long_healthy"]["errors"] else "")
+            + ".")
+
 def _load_limit(li: dict, tb: dict) -> str:
     """The bullet on the rotor-resistance change under load (:mod:`.identifiability`) and what the torque
     balance (:mod:`.torque_balance`) recovers of it."""
@@ -136,8 +153,7 @@ def _load_limit(li: dict, tb: dict) -> str:
   fault ({len(faulty)} runs, noise up to {max(v["noise_factor"] for v in faulty):g} x). An unknown load step
   ({", ".join(sorted({f"{v['load_step']:g}" for v in unknown}))} N m) it cannot explain: it withdraws the estimate
   (at {", ".join(sorted({f"{v['unexplained_at']:.4f}" for v in unknown}))} s) and, without a sensor fault,
-  {false_detection}. Its {tb["healthy_hours"]:.2g} healthy hours ({tb["healthy_false_alarms"]} false
-  alarms) are too few to measure a rate."""
+  {false_detection}. {long_healthy(tb)}"""
 
 
 def limits_section(r: dict) -> str:

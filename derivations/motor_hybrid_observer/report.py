@@ -8,7 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from derivations.motor_hybrid_observer.analysis import corrected_model, estimate, estimator_model, step_limit
-from derivations.motor_hybrid_observer.campaign import campaign_results
+from derivations.motor_hybrid_observer.campaign import campaign_results, torque_balance_healthy
 from derivations.motor_hybrid_observer.claims import hybrid_claims
 from derivations.motor_hybrid_observer.design import design
 from derivations.motor_hybrid_observer.experiment import CASES, DURATION, run_cases
@@ -197,7 +197,8 @@ def build(out_dir: Path, progress) -> None:
     progress("loaded operating point: equilibria with the rotor resistance raised")
     progress("loaded operating point: the torque-balance estimator's variants")
     results = _results(cases) | {"loaded_identifiability": indistinguishable_offsets(),
-                                 "torque_balance": loaded_results(), "c": c,
+                                 "torque_balance": loaded_results() | {
+                                     "long_healthy": torque_balance_healthy(progress)}, "c": c,
                                  "claims": claim_rows(claims),
                                  "claim_evidence": [c.counterexample for c in claims], "campaign": campaign}
     write_json(out_dir / "results.json", results)

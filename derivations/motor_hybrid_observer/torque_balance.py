@@ -22,10 +22,12 @@ torque 0.09 N m while the speed follows it; T_L is known.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
+from scipy.signal import lfilter
 
 import uvsym
 from derivations.motor_hybrid_observer.design import DT, F
@@ -34,9 +36,10 @@ from uvsym.diagnosis.detectors import threshold_factor
 from uvsym.faults import Profile, SensorFault
 from uvsym.sim import open_loop, simulate_system
 from uvsym.systems.signals import signals
-from uvsym.systems.system import system
+from uvsym.systems.system import System, system
 
-__all__ = ["VARIANTS", "Estimate", "estimate", "loaded_results", "loaded_run", "residual_sigma"]
+__all__ = ["VARIANTS", "Estimate", "estimate", "healthy_metrics", "loaded_plant", "loaded_results", "loaded_run",
+           "residual_sigma"]
 
 GAIN_START, GAIN, START_UNTIL = 20.0, 0.5, 0.5  # 1/s, 1/s, s
 CONFIRM = 5
@@ -69,34 +72,69 @@ def residual_sigma(motor, sigma_omega: float, sigma_i: float, dt: float = DT) ->
 
 
 def estimate(t, y, u, motor, sigma_omega: float, sigma_i: float) -> Estimate:
-    """The estimator of the module docstring on measured y (N, 3: i_sq, i_sd, omega_m) and u (N, 2)."""
+    """The estimator of the module docstring on measured y (N, 3: i_sq, i_sd, omega_m) and u (N, 2).
+
+    Each regime is a first-order linear recursion, run by ``scipy.signal.lfilter``: the speed estimate
+    with the start gain, then the tracking gain until the detection, then the torque balance alone;
+    the torque residual's and the fault estimate's low-passes."""
     c = motor.constants
     dt = float(t[1] - t[0])
     Rs, ws, J, TL = c.v("Rs"), c.v("omega_s"), c.v("J"), c.v("T_L")
     torque = c.v("n_p") * ((u[:, 0] - Rs * y[:, 0]) / ws * y[:, 0] + (u[:, 1] - Rs * y[:, 1]) / ws * y[:, 1]) - TL
     threshold = threshold_factor(FALSE_ALARMS_PER_HOUR, dt, 1) * residual_sigma(motor, sigma_omega, sigma_i, dt)
-    F2 = float(F[2, 0])
+    steps, judged = t.size - 1, t[:-1] >= START_UNTIL  # the estimator's steps k = 0 .. N - 2
     w = np.empty(t.size)
+    w[0] = motor.x_op[4]
+    started = int(np.argmax(judged)) if judged.any() else steps
+    for first, last, gain in ((0, started, GAIN_START), (started, steps, GAIN)):
+        if last > first:  # w[k + 1] = (1 - dt gain) w[k] + dt (torque[k] / J + gain y[k])
+            drive = dt * (torque[first:last] / J + gain * y[first:last, 2])
+            keep = 1.0 - dt * gain
+            w[first + 1:last + 1] = lfilter([1.0], [1.0, -keep], drive, zi=[keep * w[first]])[0]
+    outside = judged & (np.abs(y[:-1, 2] - w[:-1]) > threshold)
+    confirmed = np.flatnonzero(np.convolve(outside, np.ones(CONFIRM, int))[:steps] >= CONFIRM)
     f = np.zeros(t.size)
-    w[0], tq, ff, above = motor.x_op[4], 0.0, 0.0, 0
-    detected = unexplained = None
-    for k in range(t.size - 1):
-        r = y[k, 2] - w[k]
-        tq += dt / TORQUE_WINDOW * (torque[k] - tq)
-        if unexplained is None and t[k] >= START_UNTIL and abs(tq) > TORQUE_TOLERANCE:
-            unexplained = float(t[k])
-        if detected is None and t[k] >= START_UNTIL:
-            above = above + 1 if abs(r) > threshold else 0
-            if above >= CONFIRM:
-                detected = float(t[k])
-        gain = 0.0 if detected is not None else (GAIN_START if t[k] < START_UNTIL else GAIN)
-        w[k + 1] = w[k] + dt * (torque[k] / J + gain * r)
-        if detected is not None:
-            ff += dt / FAULT_WINDOW * (r / F2 - ff)
-        f[k + 1] = ff
+    detected = None
+    if confirmed.size:
+        k = int(confirmed[0])
+        detected = float(t[k])
+        w[k + 1:] = w[k] + np.cumsum(dt * torque[k:steps] / J)  # the gain is 0 from the detection on
+        alpha = dt / FAULT_WINDOW
+        f[k + 1:] = lfilter([alpha], [1.0, -(1.0 - alpha)], (y[k:steps, 2] - w[k:steps]) / float(F[2, 0]))
+    alpha = dt / TORQUE_WINDOW
+    low_passed = lfilter([alpha], [1.0, -(1.0 - alpha)], torque[:steps])
+    unexplained_at = np.flatnonzero(judged & (np.abs(low_passed) > TORQUE_TOLERANCE))
+    unexplained = float(t[unexplained_at[0]]) if unexplained_at.size else None
     last = t >= t[-1] - 1.0
     final = None if unexplained is not None else float(np.mean(f[last]))
     return Estimate(t, w, f, detected, unexplained, threshold, final)
+
+
+@functools.cache
+def loaded_plant(load: float = LOAD) -> System:
+    """The motor at ``load`` N m with the disturbances dRr (Ohm, entering as d = dRr x) and dT_L (N m, an
+    unknown load change): the plant of :func:`loaded_run` and of the long healthy runs' scenario."""
+    motor = uvsym.plant("induction_motor", T_L=load)
+    J = motor.constants.v("J")
+    return system("induction_motor_loaded", "motor with Rr change and unknown load step", x=motor.x, u=motor.u,
+                  d=signals(("dRr", "Ohm", "rotor-resistance change"), ("dT_L", "N m", "unknown load change"),
+                            group="disturbance"), p=motor.p, y=motor.y,
+                  rhs=lambda x, u, d, p: motor.f(x, u, d[0] * x, p) - ca.vertcat(0, 0, 0, 0, d[1] / J),
+                  output=lambda x, u, p: motor.h(x, u, p), p0=motor.p0, x_op=motor.x_op, u_op=motor.u_op)
+
+
+def healthy_metrics(scenario, result, events) -> dict:
+    """The campaign hook of the long healthy runs (``campaign_torque_balance.toml``): the estimator on the
+    run's measured outputs, told the scenario's sensor noise; ``tb_false_alarms`` (0 or 1: a detection or an
+    unexplained torque, the run being fault-free) over ``tb_judged_s`` (s from ``START_UNTIL``)."""
+    motor, plant = uvsym.plant("induction_motor", T_L=LOAD), scenario.plant
+    noise = {plant.y.names[f.channel]: f.value for f in scenario.sensor_faults if f.kind == "noise"}
+    y = np.column_stack([result["y"][n] for n in plant.y.names])
+    u = np.tile(plant.u_op, (result.t.size, 1))
+    e = estimate(result.t, y, u, motor, noise["omega_m"], noise["i_sq"])
+    return {"tb_detected_at": e.detected_at, "tb_unexplained_at": e.unexplained_at,
+            "tb_false_alarms": int(e.detected_at is not None or e.unexplained_at is not None),
+            "tb_judged_s": float(result.t[-1] - START_UNTIL)}
 
 
 def loaded_run(rr_rise: float = 1.0, load_step: float = 0.0, noise_factor: float = 1.0, fault: float = 1.0,
@@ -105,13 +143,7 @@ def loaded_run(rr_rise: float = 1.0, load_step: float = 0.0, noise_factor: float
     the point), Rr rising by ``rr_rise`` linearly over the run, an unknown load step ``load_step`` N m at
     ``LOAD_STEP_AT`` s, noise ``noise_factor`` x the study's, the speed sensor reading omega_m + 2 fault
     from ``onset``: the estimate and the true fault."""
-    motor = uvsym.plant("induction_motor", T_L=load)
-    J = motor.constants.v("J")
-    plant = system("induction_motor_loaded", "motor with Rr change and unknown load step", x=motor.x, u=motor.u,
-                   d=signals(("dRr", "Ohm", "rotor-resistance change"), ("dT_L", "N m", "unknown load change"),
-                             group="disturbance"), p=motor.p, y=motor.y,
-                   rhs=lambda x, u, d, p: motor.f(x, u, d[0] * x, p) - ca.vertcat(0, 0, 0, 0, d[1] / J),
-                   output=lambda x, u, p: motor.h(x, u, p), p0=motor.p0, x_op=motor.x_op, u_op=motor.u_op)
+    motor, plant = uvsym.plant("induction_motor", T_L=load), loaded_plant(load)
     steps = int(round(duration / DT))
     t = np.arange(steps + 1) * DT
     d = np.column_stack([rr_rise * motor.constants.v("Rr") * t / duration, load_step * (t >= LOAD_STEP_AT)])
