@@ -319,3 +319,17 @@ def test_the_limits_block_says_when_the_designed_noise_gave_false_alarms():
 
     assert "**not the 0 proved**" in _designed_rate(_figures(3, 0, false_alarms=2, healthy_hours=4.0,
                                                              false_alarms_per_hour=0.5))
+
+
+def test_the_limits_block_states_the_bands_told_twice_the_bound_without_calling_them_proved():
+    from derivations.uio_zonotope.campaign import _told
+
+    assert _told({}) == ""
+    groups = {"no fault, bands told twice the bound|2": _figures(30, 0, healthy_hours=10.0),
+              "abrupt, bands told twice the bound|2": _figures(16, detection_probability=0.75,
+                                                               median_detection_delay_s=0.05)}
+    text = _told(groups)
+    assert "0 false alarms in 10 h, as designed" in text and "as proved" not in text
+    assert "detected with probability 0.75 (16 runs, median delay 0.05 s)" in text
+    groups["no fault, bands told twice the bound|2"] |= {"false_alarms": 2, "false_alarms_per_hour": 0.2}
+    assert "**not the 0 of the design**" in _told(groups)
