@@ -343,3 +343,19 @@ def test_the_luenberger_studys_scenarios_are_its_runs(name, case):
     assert np.max(np.abs(result["luenberger"]["r_omega_m"] - mine["luenberger"]["r_omega_m"])) < 1e-9
     expected, got = study["detection_time_s"][case], _first(result, "luenberger_fd")
     assert (got is None) == (expected is None) and (got is None or abs(got - expected) < 1e-9)
+
+
+def test_the_torque_balance_hook_judges_a_healthy_run_of_its_scenario_and_sees_a_sensor_step():
+    """The campaign's metrics hook on short runs of torque_balance_motor.toml: fault-free, nothing; with a
+    speed-sensor step (2 f_s = 2 rad/s from 1 s), a detection it counts (the hook is for fault-free runs)."""
+    from derivations.motor_hybrid_observer.campaign import TORQUE_BALANCE_CAMPAIGN
+    from derivations.motor_hybrid_observer.torque_balance import START_UNTIL, healthy_metrics
+
+    table = read_scenario_file(TORQUE_BALANCE_CAMPAIGN.with_name("torque_balance_motor.toml")) | {"duration": 1.5}
+    for faults, alarms in (([], 0), ([{"sensor": "omega_m", "kind": "bias", "value": 2.0, "onset": 1.0}], 1)):
+        scenario = parse_system_scenario(table | {"faults": faults}, root=TORQUE_BALANCE_CAMPAIGN.parent)
+        row = healthy_metrics(scenario, simulate_system_scenario(scenario), [])
+        assert row["tb_false_alarms"] == alarms and row["tb_judged_s"] == pytest.approx(1.5 - START_UNTIL)
+        assert (row["tb_detected_at"] is not None) == bool(alarms) and row["tb_unexplained_at"] is None
+        if alarms:
+            assert 1.0 <= row["tb_detected_at"] < 1.01

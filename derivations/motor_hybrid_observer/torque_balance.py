@@ -120,18 +120,19 @@ def loaded_plant(load: float = LOAD) -> System:
                   d=signals(("dRr", "Ohm", "rotor-resistance change"), ("dT_L", "N m", "unknown load change"),
                             group="disturbance"), p=motor.p, y=motor.y,
                   rhs=lambda x, u, d, p: motor.f(x, u, d[0] * x, p) - ca.vertcat(0, 0, 0, 0, d[1] / J),
-                  output=lambda x, u, p: motor.h(x, u, p), p0=motor.p0, x_op=motor.x_op, u_op=motor.u_op)
+                  output=lambda x, u, p: motor.h(x, u, p), p0=motor.p0, x_op=motor.x_op, u_op=motor.u_op,
+                  constants=motor.constants)
 
 
 def healthy_metrics(scenario, result, events) -> dict:
     """The campaign hook of the long healthy runs (``campaign_torque_balance.toml``): the estimator on the
     run's measured outputs, told the scenario's sensor noise; ``tb_false_alarms`` (0 or 1: a detection or an
     unexplained torque, the run being fault-free) over ``tb_judged_s`` (s from ``START_UNTIL``)."""
-    motor, plant = uvsym.plant("induction_motor", T_L=LOAD), scenario.plant
+    plant = scenario.plant  # loaded_plant(load): the motor's constants at the scenario's load
     noise = {plant.y.names[f.channel]: f.value for f in scenario.sensor_faults if f.kind == "noise"}
     y = np.column_stack([result["y"][n] for n in plant.y.names])
     u = np.tile(plant.u_op, (result.t.size, 1))
-    e = estimate(result.t, y, u, motor, noise["omega_m"], noise["i_sq"])
+    e = estimate(result.t, y, u, plant, noise["omega_m"], noise["i_sq"])
     return {"tb_detected_at": e.detected_at, "tb_unexplained_at": e.unexplained_at,
             "tb_false_alarms": int(e.detected_at is not None or e.unexplained_at is not None),
             "tb_judged_s": float(result.t[-1] - START_UNTIL)}
