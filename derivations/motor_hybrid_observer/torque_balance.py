@@ -144,10 +144,10 @@ def loaded_run(rr_rise: float = 1.0, load_step: float = 0.0, noise_factor: float
     the point), Rr rising by ``rr_rise`` linearly over the run, an unknown load step ``load_step`` N m at
     ``LOAD_STEP_AT`` s, noise ``noise_factor`` x the study's, the speed sensor reading omega_m + 2 fault
     from ``onset``: the estimate and the true fault."""
-    motor, plant = uvsym.plant("induction_motor", T_L=load), loaded_plant(load)
+    plant = loaded_plant(load)  # carries the motor's constants at that load
     steps = int(round(duration / DT))
     t = np.arange(steps + 1) * DT
-    d = np.column_stack([rr_rise * motor.constants.v("Rr") * t / duration, load_step * (t >= LOAD_STEP_AT)])
+    d = np.column_stack([rr_rise * plant.constants.v("Rr") * t / duration, load_step * (t >= LOAD_STEP_AT)])
     faults = [SensorFault(plant.y.index(n), "noise", noise_factor * s) for n, s in NOISE.items()]
     if fault:
         faults.append(SensorFault(plant.y.index("omega_m"), "bias", float(F[2, 0]) * fault,
@@ -157,7 +157,7 @@ def loaded_run(rr_rise: float = 1.0, load_step: float = 0.0, noise_factor: float
                              sensor_faults=tuple(faults), d=d, seed=seed, compiled=True)
     y = np.column_stack([result["y"][n] for n in plant.y.names])
     u = np.tile(plant.u_op, (result.t.size, 1))
-    est = estimate(result.t, y, u, motor, noise_factor * NOISE["omega_m"], noise_factor * NOISE["i_sq"])
+    est = estimate(result.t, y, u, plant, noise_factor * NOISE["omega_m"], noise_factor * NOISE["i_sq"])
     return {"estimate": est, "fault": fault, "rr_rise": rr_rise, "load_step": load_step, "noise_factor": noise_factor,
             "onset": onset}
 

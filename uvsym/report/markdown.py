@@ -27,8 +27,8 @@ def limits_block(body: str) -> str:
     """A study's measured limits (Markdown without links or images: a doc page includes it from the report,
     between the two LIMITS_MARKERS, with MyST's ``{include}``)."""
     if "](" in body:
-        raise FileFormatError("a limits block holds no links or images: the doc page that includes it resolves them "
-                         "from its own folder")
+        raise FileFormatError("a limits block holds no links or images: the doc page that includes it resolves "
+                              "them from its own folder")
     return f"{LIMITS_MARKERS[0]}\n\n{body.strip()}\n\n{LIMITS_MARKERS[1]}"
 
 
