@@ -14,6 +14,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from uvsym.codegen import lane_width
 from uvsym.codegen.compile import compile_lanes, compile_roll, find_compiler, vector_doubles
 from uvsym.errors import CodegenError
 from uvsym.sim.batch import LANES, default_lanes
@@ -42,7 +43,52 @@ def test_vector_width_is_the_processors():
         pytest.skip("no /proc/cpuinfo flags to compare with")
     expected = 8 if "avx512f" in flags else 4 if "avx" in flags else 2
     assert vector_doubles() == expected
-    assert default_lanes() == min(expected, LANES)
+    # 8 doubles: 4 or 8 lanes as measured on this machine; narrower vectors: one vector, at most LANES
+    assert default_lanes() in ((4, 8) if expected == 8 else (min(expected, LANES),))
+
+
+def test_the_measured_width_is_cached_per_machine_and_measured_again_when_unreadable(tmp_path, monkeypatch):
+    """On a processor of 8 doubles the choice is measured (both widths timed), written to the cache folder's
+    lanes.json, read back without measuring, and measured again when the file is corrupt; narrower processors
+    measure nothing."""
+    calls = []
+
+    def timings():
+        calls.append(1)
+        return {4: 100.0, 8: 60.0}  # 8 lanes 1.67x faster per trajectory-step: kept
+
+    monkeypatch.setenv("UVSYM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(lane_width, "vector_doubles", lambda: 8)
+    monkeypatch.setattr(lane_width, "lane_timings", timings)
+    lane_width._measured.cache_clear()
+    assert lane_width.measured_lanes() == 8 and len(calls) == 1
+    lane_width._measured.cache_clear()
+    assert lane_width.measured_lanes() == 8 and len(calls) == 1  # read from lanes.json
+    (tmp_path / "lanes.json").write_text("{not json")
+    lane_width._measured.cache_clear()
+    monkeypatch.setattr(lane_width, "lane_timings", lambda: calls.append(1) or {4: 100.0, 8: 95.0})
+    assert lane_width.measured_lanes() == 4 and len(calls) == 2  # 5 % faster is not enough for 8
+    monkeypatch.setattr(lane_width, "vector_doubles", lambda: 4)
+    assert lane_width.measured_lanes() == 4 and len(calls) == 2
+    lane_width._measured.cache_clear()
+
+
+def test_the_calibration_loop_times_both_widths_and_its_lanes_equal_the_scalar_roll():
+    if vector_doubles() < 4:
+        pytest.skip("this processor has no 256-bit vectors")
+    timings = lane_width.lane_timings(steps=200, calls=2)
+    assert set(timings) == set(lane_width.CANDIDATES) and all(0 < t < 1e6 for t in timings.values())
+    step, N, lanes = lane_width.calibration_step(), 300, 8
+    rng = np.random.default_rng(3)
+    z0 = rng.uniform(-1.0, 1.0, (lane_width.N_Z, lanes))
+    Ws = [np.ascontiguousarray(rng.uniform(-1.0, 1.0, (N, lane_width.N_W))) for _ in range(lanes)]
+    outs = [np.empty((N, lane_width.N_OUT)) for _ in range(lanes)]
+    compile_lanes(step, lanes).runs(z0, Ws, outs)
+    for lane in range(lanes):
+        own = np.empty((N, lane_width.N_OUT))
+        compile_roll(step)(z0[:, lane], Ws[lane], own)
+        np.testing.assert_allclose(outs[lane], own, rtol=1e-12, atol=1e-14)
+        assert np.all(np.abs(outs[lane]) < 2.0)  # bounded: the loop times arithmetic, not overflow
 
 
 def _vector_symbols(library: Path) -> set[str]:

@@ -30,7 +30,8 @@ from typing import Sequence
 import numpy as np
 
 from uvsym.codegen.cache import frozen, memoized
-from uvsym.codegen.compile import compile_lanes, vector_doubles
+from uvsym.codegen.compile import compile_lanes
+from uvsym.codegen.lane_width import measured_lanes
 from uvsym.errors import CodegenError, SimulationError
 from uvsym.sim.closed_loop import build_closed_loop
 from uvsym.sim.inputs import CompactInputs, input_column, input_rows
@@ -42,18 +43,17 @@ from uvsym.sim.step_error import checked_runs
 
 __all__ = ["LANES", "default_lanes", "simulate_batch", "run_lanes"]
 
-LANES = 4  # trajectories per compiled step on AVX2 and AVX-512 processors (see default_lanes)
+LANES = 4  # trajectories per compiled step where the processor's vectors hold 4 doubles or more (see default_lanes)
 
 
 def default_lanes() -> int:
-    """Trajectories per compiled step on this processor: one vector of doubles, at most ``LANES``.
-
-    On AVX-512 (8 doubles) the docking loop's compiled lanes measured slower at 8 than at 4 (256 against
-    220 ns per trajectory-step over 10,000 steps, ``benchmarks/campaign.py`` times 4, 8 and 16): its steps
-    stream about 1.1 KB of inputs and outputs each, and the wider step waits on memory; a processor with
-    2 doubles per vector gets 2.
+    """Trajectories per compiled step on this processor (:func:`~uvsym.codegen.lane_width.measured_lanes`):
+    one vector of doubles, at most ``LANES``, on processors of 2 or 4 doubles per vector; on AVX-512 (8
+    doubles) 8 where a calibration loop measured them clearly faster than 4, else 4 (some processors run
+    512-bit arithmetic at half the rate of 256-bit, and the docking loop's 8 lanes measured 256 against 220 ns
+    per trajectory-step there), measured once per machine and cached.
     """
-    return min(vector_doubles(), LANES)
+    return measured_lanes()
 
 
 def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: int = 1, compiled: bool = True,
