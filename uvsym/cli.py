@@ -456,6 +456,10 @@ def _cmd_verify(args) -> int:
 def _cmd_campaign(args) -> int:
     from uvsym.campaign.spec import load_campaign
 
+    if not args.dry_run and args.executor in (None, "local") and args.scheduler is None:
+        from uvsym.campaign.executors import start_forkserver
+
+        start_forkserver()  # the workers' imports run while the campaign's runs are read and checked
     campaign = load_campaign(args.file, confirm=args.yes)
     from uvsym.campaign.runner import default_out, run_campaign
     from uvsym.progress import ProgressBar
