@@ -206,3 +206,29 @@ def test_the_dc_motor_step_runs_its_lanes_in_vector_registers():
     arithmetic = r"v(add|sub|mul|div|fn?m(add|sub)\d*)"
     packed, scalar = len(re.findall(arithmetic + "pd", body)), len(re.findall(arithmetic + "sd", body))
     assert packed > 10 * max(scalar, 1), (packed, scalar)
+
+
+def test_the_runs_roll_keeps_each_lanes_largest_state_and_finds_its_first_non_finite_row():
+    """z_max: the largest |z_i| of z_0 .. z_k (out logs z_k before each step, z_end is z_k); first_bad: the
+    first step whose row holds 1/0 or 0/0 in that lane only, counted within the call; -1 elsewhere."""
+    z, w = ca.SX.sym("z", 2), ca.SX.sym("w", 1)
+    step = ca.Function("lanes_watch", [z, w], [ca.vertcat(0.9 * z[0] + ca.sin(w), z[1] - 0.5),
+                                              ca.vertcat(z, 1.0 / w, w / w)])
+    lanes, N = 4, 60
+    roll = compile_lanes(step, lanes)
+    rng = np.random.default_rng(5)
+    z0 = np.ascontiguousarray(rng.uniform(-3.0, 3.0, (2, lanes)))
+    Ws = [np.ascontiguousarray(rng.uniform(0.5, 2.0, (N, 1))) for _ in range(lanes)]
+    Ws[2][37, 0] = 0.0  # 1 / 0 and 0 / 0 at step 37 of lane 2
+    outs = [np.empty((N, 4)) for _ in range(lanes)]
+    z_max, first_bad = np.zeros((2, lanes)), np.full(lanes, -1, dtype=np.int_)
+    z_end = roll.runs(z0, Ws, outs, z_max, first_bad)
+    assert first_bad.tolist() == [-1, -1, 37, -1]
+    for lane in range(lanes):
+        states = np.vstack([outs[lane][:, :2], z_end[:, lane]])
+        np.testing.assert_array_equal(z_max[:, lane], np.abs(states).max(axis=0))
+    again = roll.runs(z_end, [W[:5] for W in Ws], [out[:5] for out in outs], z_max, first_bad)
+    assert first_bad.tolist() == [-1, -1, 37, -1]  # kept: the first bad step is the caller's to clear
+    assert np.all(z_max >= np.abs(again))
+    with pytest.raises(CodegenError, match="z_max"):
+        roll.runs(z0, Ws, outs, np.zeros((2, lanes + 1)), first_bad)

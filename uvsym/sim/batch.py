@@ -192,13 +192,16 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         padding = lanes - len(group)  # padding lanes repeat the last run, into its own rows (the same values)
         lane_W, lane_out = Ws + Ws[-1:] * padding, outputs + outputs[-1:] * padding
         z = np.stack([run.z0 for run in group] + [group[-1].z0] * padding, axis=-1)
+        # the roll keeps each lane's largest |z| (the step check's scale) and finds its non-finite output rows
+        z_max, first_bad = np.zeros_like(z), np.full(lanes, -1, dtype=np.int_)
         for start in range(0, N, CHUNK["fast"]):
             k = min(CHUNK["fast"], N - start)
-            z = roll.runs(z, [W[start:start + k] for W in lane_W], [out[start:start + k] for out in lane_out])
+            z = roll.runs(z, [W[start:start + k] for W in lane_W], [out[start:start + k] for out in lane_out],
+                          z_max, first_bad)
             for lane, (W, out, run) in enumerate(zip(Ws, outputs, group)):
                 W_rows, rows = W[start:start + k], out[start:start + k]
                 try:
-                    if not (np.isfinite(rows).all() and np.isfinite(z[:, lane]).all()):
+                    if first_bad[lane] >= 0 or not np.isfinite(z[:, lane]).all():
                         check_chunk(loop, "fast", start, input_rows(W_rows, slice(None)), rows, z[:, lane], run.guard)
                     elif run.guard is not None:
                         run.guard(input_column(W_rows, 0), rows)
@@ -211,7 +214,9 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         checked = [(lane, (out, W, run.rk4_tolerance, run.actuator_faults))  # as the scalar path checks them,
                    for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))  # all in one call
                    if run.rk4_tolerance is not None]
-        errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked], compiled=True)))
+        state_max = [z_max[:loop.n_s, lane] for lane, _ in checked]  # s = z[:n_s], over z_0 .. z_N
+        errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked], compiled=True,
+                                                                      state_max=state_max)))
         for lane, (run, W, out) in enumerate(zip(group, Ws, outputs)):  # views of the run's rows: no copy
             signals = {name: Signal(out[:, sl], labels, units) for name, (sl, labels, units) in loop.signals.items()}
             meta = {**run.meta, "lanes": lanes, "wall_s": wall, "build_s": build_s}

@@ -60,7 +60,11 @@ class ClosedLoop(SampledLoop):
     def integrated(self, out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """s = [x; a] (a: the actuators' own state, u_actual less its fault) and u_command, per logged row."""
         a = self.logged(out, "u_actual") - self.logged(out, "fault_actuator")
-        return np.hstack([self.logged(out, "x"), a]), self.logged(out, "u_command")
+        return np.hstack([self.logged(out, "x"), a]), self.held_inputs(out)
+
+    def held_inputs(self, out: np.ndarray) -> np.ndarray:
+        """u_command per logged row: the plant inputs held over each sample."""
+        return self.logged(out, "u_command")
 
 
 def _by_name(names: tuple[str, ...], available: dict, observer: str):

@@ -56,6 +56,10 @@ class SampledLoop:
         for a loop that does not say (its fast path's step error is then not checked)."""
         return None
 
+    def held_inputs(self, out: np.ndarray) -> np.ndarray:
+        """u_cmd (k, m) of :meth:`integrated` alone (a loop may read it back without the state)."""
+        return self.integrated(out)[1]
+
     def logged(self, out: np.ndarray, name: str) -> np.ndarray:
         """The columns of the logged signal ``name`` in logged rows ``out`` (k, n_out)."""
         return out[:, self.signals[name][0]]

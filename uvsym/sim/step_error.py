@@ -156,16 +156,18 @@ def step_error(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float) -> St
     return step_errors(loop, [(outputs, W, tolerance, None)])[0]
 
 
-def step_errors(loop, runs, compiled: bool = False) -> list[StepError | None]:
+def step_errors(loop, runs, compiled: bool = False, state_max=None) -> list[StepError | None]:
     """:func:`step_error` of each run ``(outputs, W, tolerance, faults)`` of one loop, every checked step of every
     run in one call of the doubled step mapped over them all (compiled: its C, as compiled loops want). faults:
     the run's actuator faults where they are not the loop's own (``loop.actuator_faults``: a loop shared by
-    runs of other faults, which its w carries), else None."""
+    runs of other faults, which its w carries), else None. state_max: one (n_s,) per run, the largest |s_i| of
+    its states z_0 .. z_N (s = z[:n_s]) as the runner kept them, or None to read them back from the logged rows."""
     if loop.plant_ode is None:
         return [None] * len(runs)
     faults = [loop.actuator_faults if run_faults is None else run_faults for *_, run_faults in runs]
-    plans = [_plan(loop, outputs, W, tolerance, run_faults)
-             for (outputs, W, tolerance, _), run_faults in zip(runs, faults)]
+    state_max = [None] * len(runs) if state_max is None else state_max
+    plans = [_plan(loop, outputs, W, tolerance, run_faults, largest)
+             for (outputs, W, tolerance, _), run_faults, largest in zip(runs, faults, state_max)]
     checked = [i for i, plan in enumerate(plans) if plan is not None and plan[-1]]
     if checked:
         coarse, fine = _redone(loop, [plans[i] for i in checked], [faults[i] for i in checked], compiled)
@@ -222,18 +224,22 @@ def _stage_faults(loop, faults, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return dense[0].reshape(len(t), -1).T, dense[1].reshape(len(t), -1).T
 
 
-def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults):
+def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults, state_max=None):
     """(scale, outputs, W, checked samples) of a run's step check, or None where nothing can be checked. The
-    logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small). The steps where an
-    actuator fault switches: from ``faults`` (its profiles' jumps) where given, else where the logged
-    ``fault_actuator`` turns zero or non-zero."""
+    logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small): the held inputs, and
+    each state entry's largest |value| unless ``state_max`` (n_s,) gives it. The steps where an actuator fault
+    switches: from ``faults`` (its profiles' jumps) where given, else where the logged ``fault_actuator`` turns
+    zero or non-zero."""
     if len(W) < 2 or loop.integrated(outputs[:1]) is None:
         return None
     largest, inputs, faulty = [], [], []
     for start in range(0, len(outputs), _ROWS):
         rows = outputs[start:start + _ROWS]
-        S, U = loop.integrated(rows)
-        largest.append(_column_max(S))
+        if state_max is None:
+            S, U = loop.integrated(rows)
+            largest.append(_column_max(S))
+        else:
+            U = loop.held_inputs(rows)
         inputs.append(U.T)
         if faults is None:
             faulty.append(loop.logged(rows, "fault_actuator").T != 0)
@@ -246,7 +252,8 @@ def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults):
         switching = np.zeros(len(t), dtype=bool)
         for fault in faults:
             switching |= fault.profile.jumps(t, loop.dt)
-    return tolerance * np.max(largest, axis=0) + ATOL, outputs, W, check_indices(U, switching)
+    scale = np.max(largest, axis=0) if state_max is None else np.asarray(state_max, dtype=float)
+    return tolerance * scale + ATOL, outputs, W, check_indices(U, switching)
 
 
 def state_name(loop, entry: int) -> str:
@@ -263,11 +270,11 @@ def checked_steps(loop, outputs: np.ndarray, W: np.ndarray, tolerance: float, fa
     return checked_runs(loop, [(outputs, W, tolerance, faults)], stacklevel=5)[0]
 
 
-def checked_runs(loop, runs, stacklevel: int = 4, compiled: bool = False) -> list[dict | None]:
+def checked_runs(loop, runs, stacklevel: int = 4, compiled: bool = False, state_max=None) -> list[dict | None]:
     """:func:`checked_steps` of each run ``(outputs, W, tolerance, faults)`` of one loop (:func:`step_errors`, compiled
-    as it says); stacklevel: the warnings', counted from this function."""
+    and state_max as it says); stacklevel: the warnings', counted from this function."""
     metas = []
-    for (_, _, tolerance, _), error in zip(runs, step_errors(loop, runs, compiled)):
+    for (_, _, tolerance, _), error in zip(runs, step_errors(loop, runs, compiled, state_max)):
         if error is None:
             metas.append(None)
             continue
