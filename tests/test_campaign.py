@@ -81,6 +81,11 @@ def killer(scenario, result, events):
     return metrics(scenario, result, events)
 
 
+def environment(scenario, result, events):
+    return {"worker_" + key.lower(): os.environ.get(key, "unset")
+            for key in ("OPENBLAS_NUM_THREADS", "PYTHONSAFEPATH", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")}
+
+
 def shadowing(scenario, result, events):
     return {"seed": 0}
 
@@ -519,6 +524,21 @@ def test_workers_import_the_drivers_uvsym_not_a_folder_named_uvsym_in_the_workin
     rows = pq.read_table(work / "out" / "results.parquet").to_pylist()
     assert [r["status"] for r in rows] == ["ok", "ok"], [r["error"] for r in rows]
     assert sorted(_executed(work)) == [1, 2]
+
+
+def test_local_workers_run_single_threaded_with_a_safe_path_and_malloc_keeping_freed_tables(tmp_path):
+    """The workers' environment (uvsym.campaign.executors), in a new driver process (the forkserver keeps the
+    environment it started with): one BLAS thread, no working folder on sys.path, glibc's malloc serving the
+    output tables from its heap; a value the user set is kept."""
+    environment = {key: value for key, value in os.environ.items() if not key.startswith(("MALLOC_", "OPENBLAS"))}
+    path = _tiny(tmp_path, "environment", seeds=(1,))
+    run = subprocess.run([sys.executable, "-m", "uvsym.cli", "campaign", str(path), "--out", str(tmp_path / "out")],
+                         env=environment | {"MALLOC_TRIM_THRESHOLD_": "12345"}, capture_output=True, text=True,
+                         timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
+    row = pq.read_table(tmp_path / "out" / "results.parquet").to_pylist()[0]
+    assert (row["worker_openblas_num_threads"], row["worker_pythonsafepath"]) == ("1", "1")
+    assert (row["worker_malloc_mmap_threshold_"], row["worker_malloc_trim_threshold_"]) == (str(32 * 2 ** 20), "12345")
 
 
 def test_a_run_whose_worker_died_once_is_tried_again_in_a_new_process(tmp_path):

@@ -43,13 +43,18 @@ _SINGLE_THREADED = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NU
 # there named uvsym (the parent of a checkout) would be the uvsym its preload imports and every worker inherits.
 # Without it (safe path) the forkserver finds the parent's uvsym; each worker then takes the parent's sys.path.
 _SAFE_PATH = {"PYTHONSAFEPATH": "1"}
+# glibc's malloc, read at each process's start: a worker allocates the same few-megabyte output tables run after
+# run; from the heap (up to 32 MiB an allocation) and kept there when freed (up to 1 GiB), they come back without
+# the page faults and zeroing of fresh pages (the docking campaign: 6.8 against 5.3 ms per 100 s run). Peak
+# memory is the same; other C libraries ignore these.
+_MALLOC = {"MALLOC_MMAP_THRESHOLD_": str(32 * 2 ** 20), "MALLOC_TRIM_THRESHOLD_": str(2 ** 30)}
 
 
 @contextlib.contextmanager
 def _worker_environment():
-    """os.environ with _SINGLE_THREADED and _SAFE_PATH where the user set none, for processes (and the forkserver)
-    started inside."""
-    added = {key: value for key, value in (_SINGLE_THREADED | _SAFE_PATH).items() if key not in os.environ}
+    """os.environ with _SINGLE_THREADED, _SAFE_PATH and _MALLOC where the user set none, for processes (and the
+    forkserver) started inside."""
+    added = {key: value for key, value in (_SINGLE_THREADED | _SAFE_PATH | _MALLOC).items() if key not in os.environ}
     os.environ.update(added)
     try:
         yield
