@@ -435,6 +435,16 @@ def test_a_tiny_campaign_on_local_processes(local_run):
     assert again.to_pylist() == rows and sorted(_executed(folder)) == [1, 2]
 
 
+def test_the_results_of_the_chunks_a_run_wrote_equal_its_chunk_files_read_back(local_run):
+    """run_campaign keeps the chunks it wrote rather than reading them back: the same table as a new store's."""
+    from uvsym.campaign.store import ResultStore
+
+    folder, campaign, table = local_run
+    again = ResultStore(folder / "out", campaign.name).results([run.id for run in campaign.runs])
+    assert again.num_rows == 2 and again.equals(table)
+    assert pq.read_table(folder / "out" / "results.parquet").equals(table)
+
+
 def test_the_same_campaign_on_a_dask_local_cluster(local_run, tmp_path):
     distributed = pytest.importorskip("distributed", reason="dask.distributed is not installed "
                                                             "(pip install 'uvsym[cluster]')")

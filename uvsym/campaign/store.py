@@ -89,6 +89,7 @@ class ResultStore:
         claim_folder(self.folder, f"the campaign {name}", "report", force, writer=("campaign", name))
         record = self._record()
         self.files = dict(record.get("files") or {}) if isinstance(record, dict) else {}
+        self._written: dict[Path, pa.Table] = {}  # the chunks this store wrote, as read back: not read again
 
     def create(self) -> None:
         """Make the folder, its chunks/ and its record (after every check, before the first run: a campaign
@@ -135,6 +136,7 @@ class ResultStore:
         buffer = io.BytesIO()
         pq.write_table(to_table(rows, kinds), buffer)
         data = buffer.getvalue()
+        table = pq.read_table(pa.BufferReader(data))  # as results() would read the file back
         ids = hashlib.sha256("\n".join(row["run_id"] for row in rows).encode()).hexdigest()[:16]
         rel = f"chunks/chunk-{ids}.parquet"
         self.files[rel] = hashlib.sha256(data).hexdigest()
@@ -142,11 +144,12 @@ class ResultStore:
         temporary = self.folder / f"{rel}.part"
         temporary.write_bytes(data)
         os.replace(temporary, self.folder / rel)
+        self._written[self.folder / rel] = table
         return self.folder / rel
 
     def results(self, run_ids: list[str]) -> pa.Table:
         """The rows of the runs ``run_ids`` found in the chunk files, in that order (each once)."""
-        tables = [pq.read_table(path) for path in self.chunk_files()]
+        tables = [self._written[path] if path in self._written else pq.read_table(path) for path in self.chunk_files()]
         if not tables:
             return to_table([], {})
         table = merge_tables(tables)
