@@ -111,24 +111,29 @@ class LocalExecutor:
         rows: dict[int, dict] = {index: {} for index in left}
         idle = [self._spawn(settings) for _ in range(min(self.workers, len(pending)))]
         busy: dict = {}  # (process, conn) -> (chunk index, runs)
-        lost = 0  # processes found dead while idle
+        lost = [0]  # processes found dead while idle
         deaths: dict[str, int] = {}  # run id -> worker processes that died under it alone
+
+        def dispatch() -> None:
+            """A pending job to each idle process."""
+            while idle and pending:
+                slot, job = idle.pop(), pending.popleft()
+                try:
+                    slot[1].send(job[1])
+                except OSError:  # the idle process has gone: replace it, the job waits for the next
+                    lost[0] += 1
+                    if lost[0] > 2 * self.workers:
+                        raise ExecutorError(f"{lost[0]} local worker processes ended before taking a run "
+                                            f"(last exit code {slot[0].exitcode})") from None
+                    pending.appendleft(job)
+                    self._processes.remove(slot)
+                    idle.append(self._spawn(settings))
+                    continue
+                busy[slot] = job
+
         try:
             while pending or busy:
-                while idle and pending:
-                    slot, job = idle.pop(), pending.popleft()
-                    try:
-                        slot[1].send(job[1])
-                    except OSError:  # the idle process has gone: replace it, the job waits for the next
-                        lost += 1
-                        if lost > 2 * self.workers:
-                            raise ExecutorError(f"{lost} local worker processes ended before taking a run "
-                                                f"(last exit code {slot[0].exitcode})") from None
-                        pending.appendleft(job)
-                        self._processes.remove(slot)
-                        idle.append(self._spawn(settings))
-                        continue
-                    busy[slot] = job
+                dispatch()
                 ready = set(wait([s[1] for s in busy] + [s[0].sentinel for s in busy]))
                 for slot in [s for s in busy if s[1] in ready or s[0].sentinel in ready]:
                     (process, conn), (index, runs) = slot, busy.pop(slot)
@@ -149,6 +154,7 @@ class LocalExecutor:
                             continue
                     else:
                         idle.append(slot)
+                        dispatch()  # its next job before this one's rows are written: the process never waits on them
                     for run, row in zip(runs, answer):
                         rows[index][run.id] = row
                     left[index] -= len(runs)
