@@ -68,11 +68,16 @@ def _processor() -> str:
     return f"{platform.machine()} {platform.processor()} {platform.platform()}"
 
 
+def machine_identity(compiler: str) -> tuple[str, ...]:
+    """What a compiled library depends on besides its source and flags: the compiler's path and version, the
+    processor (model and feature flags) and CasADi's version."""
+    return compiler, _compiler_identity(compiler), _processor(), ca.__version__
+
+
 def library_key(f: ca.Function, extra_source: str, flags: tuple[str, ...], compiler: str) -> str:
-    """Hex SHA-256 of ``f.serialize()``, ``extra_source``, ``flags``, the compiler, processor and CasADi version."""
+    """Hex SHA-256 of ``f.serialize()``, ``extra_source``, ``flags`` and :func:`machine_identity`."""
     digest = hashlib.sha256()
-    for part in (f.serialize(), extra_source, "\0".join(flags), compiler, _compiler_identity(compiler), _processor(),
-                 ca.__version__):
+    for part in (f.serialize(), extra_source, "\0".join(flags), *machine_identity(compiler)):
         digest.update(part.encode() if isinstance(part, str) else bytes(part))
         digest.update(b"\0\1\0")
     return digest.hexdigest()

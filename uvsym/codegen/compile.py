@@ -180,7 +180,7 @@ def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
         compact inputs with ``constant`` (n_w,), ``columns`` (n_var,) and ``rows`` (k, n_var) as
         :class:`~uvsym.sim.inputs.CompactInputs` holds them) and writes outs[l] (k, n_out) (lanes may share
         an array, a padding lane its run's); z0, z_end (n_z, L). Updated in place where given: z_max (n_z, L)
-        float64, the largest |z| of each entry from z0 on, and first_bad (L,) np.int_, each lane's first step (of
+        float64, the largest ``abs(z)`` of each entry from z0 on, and first_bad (L,) np.int_, each lane's first step (of
         this call) whose output row is not finite where it holds -1."""
         z0 = np.ascontiguousarray(z0, dtype=float)
         z_max = np.zeros((n_z, lanes)) if z_max is None else z_max

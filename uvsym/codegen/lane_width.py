@@ -23,7 +23,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from uvsym.codegen.cache import _compiler_identity, _processor, cache_dir
+from uvsym.codegen.cache import cache_dir, machine_identity
 from uvsym.codegen.compile import compile_lanes, find_compiler, vector_doubles
 from uvsym.errors import CodegenError
 
@@ -69,9 +69,8 @@ def lane_timings(candidates=CANDIDATES, steps: int = STEPS, calls: int = CALLS) 
 
 
 def _machine_key() -> str:
-    compiler = find_compiler() or ""
-    parts = (compiler, _compiler_identity(compiler) if compiler else "", _processor(), ca.__version__)
-    return hashlib.sha256("\0".join(parts).encode()).hexdigest()[:24]
+    """This machine's entry in lanes.json: a hash of :func:`~uvsym.codegen.cache.machine_identity`."""
+    return hashlib.sha256("\0".join(machine_identity(find_compiler() or "")).encode()).hexdigest()[:24]
 
 
 def _read(path: Path) -> dict:

@@ -160,7 +160,7 @@ def step_errors(loop, runs, compiled: bool = False, state_max=None) -> list[Step
     """:func:`step_error` of each run ``(outputs, W, tolerance, faults)`` of one loop, every checked step of every
     run in one call of the doubled step mapped over them all (compiled: its C, as compiled loops want). faults:
     the run's actuator faults where they are not the loop's own (``loop.actuator_faults``: a loop shared by
-    runs of other faults, which its w carries), else None. state_max: one (n_s,) per run, the largest |s_i| of
+    runs of other faults, which its w carries), else None. state_max: one (n_s,) per run, the largest ``abs(s_i)`` of
     its states z_0 .. z_N (s = z[:n_s]) as the runner kept them, or None to read them back from the logged rows."""
     if loop.plant_ode is None:
         return [None] * len(runs)
@@ -227,7 +227,7 @@ def _stage_faults(loop, faults, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults, state_max=None):
     """(scale, outputs, W, checked samples) of a run's step check, or None where nothing can be checked. The
     logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small): the held inputs, and
-    each state entry's largest |value| unless ``state_max`` (n_s,) gives it. The steps where an actuator fault
+    each state entry's largest absolute value unless ``state_max`` (n_s,) gives it. The steps where an actuator fault
     switches: from ``faults`` (its profiles' jumps) where given, else where the logged ``fault_actuator`` turns
     zero or non-zero."""
     if len(W) < 2 or loop.integrated(outputs[:1]) is None:
