@@ -456,7 +456,7 @@ def _cmd_verify(args) -> int:
 def _cmd_campaign(args) -> int:
     from uvsym.campaign.spec import load_campaign
 
-    if not args.dry_run and args.executor in (None, "local") and args.scheduler is None:
+    if Path(args.file).is_file() and not args.dry_run and args.executor in (None, "local") and args.scheduler is None:
         from uvsym.campaign.executors import start_forkserver
 
         start_forkserver()  # the workers' imports run while the campaign's runs are read and checked
