@@ -230,5 +230,11 @@ def test_the_runs_roll_keeps_each_lanes_largest_state_and_finds_its_first_non_fi
     again = roll.runs(z_end, [W[:5] for W in Ws], [out[:5] for out in outs], z_max, first_bad)
     assert first_bad.tolist() == [-1, -1, 37, -1]  # kept: the first bad step is the caller's to clear
     assert np.all(z_max >= np.abs(again))
+    first, fresh = np.zeros((1, lanes)), [np.empty((N, 4)) for _ in range(lanes)]  # the first entry only
+    z_end = roll.runs(z0, Ws, fresh, first, np.full(lanes, -1, dtype=np.int_))
+    for lane in range(lanes):
+        assert first[0, lane] == np.abs(np.append(fresh[lane][:, 0], z_end[0, lane])).max()
     with pytest.raises(CodegenError, match="z_max"):
         roll.runs(z0, Ws, outs, np.zeros((2, lanes + 1)), first_bad)
+    with pytest.raises(CodegenError, match="z_max"):
+        roll.runs(z0, Ws, outs, np.zeros((3, lanes)), first_bad)  # more entries than z has

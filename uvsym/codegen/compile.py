@@ -170,8 +170,8 @@ def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
     n_z, n_w, n_out = step.nnz_in(0), step.nnz_in(1), step.nnz_out(1)
     pointers, counts = ctypes.c_void_p * lanes, ctypes.c_long * lanes
     function = getattr(ctypes.CDLL(str(library)), symbol)
-    function.argtypes = [_POINTER, pointers, pointers, counts, pointers, _POINTER, pointers, ctypes.c_long, _POINTER,
-                         ctypes.POINTER(ctypes.c_long)]
+    function.argtypes = [_POINTER, pointers, pointers, counts, pointers, _POINTER, pointers, ctypes.c_long,
+                         ctypes.c_long, _POINTER, ctypes.POINTER(ctypes.c_long)]
     every_column, unused = np.arange(n_w, dtype=np.int_), np.zeros(n_w)  # a dense W: every column varies
 
     def runs(z0: np.ndarray, Ws: list, outs: list[np.ndarray], z_max: np.ndarray | None = None,
@@ -179,15 +179,16 @@ def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
         """k steps of every lane: lane l reads the rows of Ws[l] (k, n_w: a C-contiguous float64 array, or
         compact inputs with ``constant`` (n_w,), ``columns`` (n_var,) and ``rows`` (k, n_var) as
         :class:`~uvsym.sim.inputs.CompactInputs` holds them) and writes outs[l] (k, n_out) (lanes may share
-        an array, a padding lane its run's); z0, z_end (n_z, L). Updated in place where given: z_max (n_z, L)
-        float64, the largest ``abs(z)`` of each entry from z0 on, and first_bad (L,) np.int_, each lane's first step (of
-        this call) whose output row is not finite where it holds -1."""
+        an array, a padding lane its run's); z0, z_end (n_z, L). Updated in place where given: z_max (n_max, L)
+        float64 (n_max <= n_z), the largest ``abs(z)`` of each of the first n_max entries from z0 on, and first_bad
+        (L,) np.int_, each lane's first step (of this call) whose output row is not finite where it holds -1."""
         z0 = np.ascontiguousarray(z0, dtype=float)
-        z_max = np.zeros((n_z, lanes)) if z_max is None else z_max
+        z_max = np.zeros((0, lanes)) if z_max is None else z_max
         first_bad = np.full(lanes, -1, dtype=np.int_) if first_bad is None else first_bad
-        if not (z_max.shape == (n_z, lanes) and z_max.dtype == np.float64 and z_max.flags.c_contiguous
+        if not (z_max.ndim == 2 and z_max.shape[0] <= n_z and z_max.shape[1] == lanes and z_max.dtype == np.float64
+                and z_max.flags.c_contiguous
                 and first_bad.shape == (lanes,) and first_bad.dtype == np.int_ and first_bad.flags.c_contiguous):
-            raise CodegenError(f"the lanes' runs need z_max ({n_z}, {lanes}) float64 and first_bad ({lanes},) "
+            raise CodegenError(f"the lanes' runs need z_max (at most {n_z}, {lanes}) float64 and first_bad ({lanes},) "
                                "of np.int_, C-contiguous")
         k = Ws[0].shape[0] if len(Ws) else 0
         parts = [(unused, every_column, W) if isinstance(W, np.ndarray) else (W.constant, W.columns, W.rows)
@@ -207,7 +208,7 @@ def _runs_roller(step: ca.Function, library: Path, symbol: str, lanes: int):
         if function(z0.ctypes.data_as(_POINTER), pointers(*(c.ctypes.data for c, _, _ in parts)),
                     pointers(*(j.ctypes.data for _, j, _ in parts)), counts(*(j.size for _, j, _ in parts)),
                     pointers(*(r.ctypes.data for _, _, r in parts)), z_end.ctypes.data_as(_POINTER),
-                    pointers(*(out.ctypes.data for out in outs)), k, z_max.ctypes.data_as(_POINTER),
+                    pointers(*(out.ctypes.data for out in outs)), k, z_max.shape[0], z_max.ctypes.data_as(_POINTER),
                     first_bad.ctypes.data_as(ctypes.POINTER(ctypes.c_long))):
             raise CodegenError(f"{step.name()} failed inside the compiled loop")
         return z_end
@@ -298,24 +299,24 @@ int {name}_lanes_roll(const double* z0, const double* W, double* z_end, double* 
 /* the same roll over each lane's own row-major arrays, gathered into and scattered from the structure of
    arrays one step at a time (in the cache: no pass over the runs' memory). Lane l's inputs: the constant
    row C_l (n_w) and the nJ_l columns J_l that vary, their rows W_l (N, nJ_l); its outputs O_l (N, n_out).
-   On the way, what a pass over the outputs would otherwise find: z_max (n_z, L) the largest |z| of each
-   state entry from z0 on (kept from the caller's values), and first_bad (L) the first step whose output row
-   holds an infinity or a NaN (told by the exponent bits, which -ffinite-math-only leaves alone; kept where the
-   caller's value is not -1), counted from 0 in this call. */
+   On the way, what a pass over the outputs would otherwise find: z_max (n_max, L) the largest |z| of each of
+   the first n_max state entries from z0 on (kept from the caller's values), and first_bad (L) the first step
+   whose output row holds an infinity or a NaN (told by the exponent bits, which -ffinite-math-only leaves
+   alone; kept where the caller's value is not -1), counted from 0 in this call. */
 static inline long {name}_not_finite(double v) {{
   unsigned long long bits;
   memcpy(&bits, &v, sizeof bits);
   return (bits & 0x7ff0000000000000ULL) == 0x7ff0000000000000ULL;
 }}
 int {name}_lanes_runs(const double* z0, const double* const* C, const long* const* J, const long* nJ,
-                      const double* const* W, double* z_end, double* const* O, long N, double* z_max,
+                      const double* const* W, double* z_end, double* const* O, long N, long n_max, double* z_max,
                       long* first_bad) {{
   double a[{n_z} * {L}], b[{n_z} * {L}], w[{n_w} * {L}], o[{n_out} * {L}];
   double *z = a, *zn = b, *swap;
   for (long l = 0; l < {L}; ++l)
     for (long j = 0; j < {n_w}; ++j) w[j * {L} + l] = C[l][j];
   memcpy(z, z0, sizeof a);
-  for (long i = 0; i < {n_z} * {L}; ++i) z_max[i] = fmax(z_max[i], fabs(z[i]));
+  for (long i = 0; i < n_max * {L}; ++i) z_max[i] = fmax(z_max[i], fabs(z[i]));
   for (long k = 0; k < N; ++k) {{
     for (long l = 0; l < {L}; ++l) {{
       const long n = nJ[l], *Jl = J[l];
@@ -332,7 +333,7 @@ int {name}_lanes_runs(const double* z0, const double* const* C, const long* cons
       }}
       if (bad && first_bad[l] < 0) first_bad[l] = k;
     }}
-    for (long i = 0; i < {n_z} * {L}; ++i) z_max[i] = fmax(z_max[i], fabs(zn[i]));
+    for (long i = 0; i < n_max * {L}; ++i) z_max[i] = fmax(z_max[i], fabs(zn[i]));
     swap = z; z = zn; zn = swap;
   }}
   memcpy(z_end, z, sizeof a);

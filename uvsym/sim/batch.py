@@ -193,7 +193,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         lane_W, lane_out = Ws + Ws[-1:] * padding, outputs + outputs[-1:] * padding
         z = np.stack([run.z0 for run in group] + [group[-1].z0] * padding, axis=-1)
         # the roll keeps each lane's largest |z| (the step check's scale) and finds its non-finite output rows
-        z_max, first_bad = np.zeros_like(z), np.full(lanes, -1, dtype=np.int_)
+        z_max, first_bad = np.zeros((loop.n_s, lanes)), np.full(lanes, -1, dtype=np.int_)  # s = z[:n_s]
         for start in range(0, N, CHUNK["fast"]):
             k = min(CHUNK["fast"], N - start)
             z = roll.runs(z, [W[start:start + k] for W in lane_W], [out[start:start + k] for out in lane_out],
@@ -214,7 +214,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
         checked = [(lane, (out, W, run.rk4_tolerance, run.actuator_faults))  # as the scalar path checks them,
                    for lane, (out, W, run) in enumerate(zip(outputs, Ws, group))  # all in one call
                    if run.rk4_tolerance is not None]
-        state_max = [z_max[:loop.n_s, lane] for lane, _ in checked]  # s = z[:n_s], over z_0 .. z_N
+        state_max = [z_max[:, lane] for lane, _ in checked]  # over z_0 .. z_N
         errors = dict(zip([lane for lane, _ in checked], checked_runs(loop, [c for _, c in checked], compiled=True,
                                                                       state_max=state_max)))
         for lane, (run, W, out) in enumerate(zip(group, Ws, outputs)):  # views of the run's rows: no copy
