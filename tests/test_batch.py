@@ -121,6 +121,9 @@ def test_a_batch_refuses_a_supervisor_and_what_is_not_a_scenario(scenarios):
         simulate_batch(scenarios, supervisor=object())
     with pytest.raises(SimulationError, match=r"scenarios\[1\] must be a Scenario or a SystemScenario, got dict"):
         simulate_batch([scenarios[0], {}])
+    for lanes in (0, -4, 2.5, True, "4"):  # a typed error, not a quiet fall back to one run after another
+        with pytest.raises(SimulationError, match=f"lanes must be a positive integer .*got {lanes!r}"):
+            simulate_batch(scenarios, lanes=lanes)
 
 
 @pytest.mark.skipif(find_compiler() is None, reason="no C compiler")

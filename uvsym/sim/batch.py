@@ -73,9 +73,11 @@ def simulate_batch(scenarios: Sequence, *, lanes: int | None = None, substeps: i
     Raises
     ------
     SimulationError
-        For a supervisor or a [diagnosis] that corrects the commands (lanes run without Python in the
-        loop), and as :func:`simulate_scenario` does for a run that diverges (naming the scenario).
+        For ``lanes`` not a positive integer, a supervisor or a [diagnosis] that corrects the commands
+        (lanes run without Python in the loop), and as :func:`simulate_scenario` does for a run that
+        diverges (naming the scenario).
     """
+    _check_lanes(lanes)
     if supervisor is not None:
         raise SimulationError("simulate_batch runs without a supervisor (no Python between the steps of the lanes); "
                               "run supervised scenarios with simulate_scenario")
@@ -162,6 +164,7 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
     batch). ``names`` label the runs in errors (default: their index). Falls back to one scalar run
     after another (with a warning) when the lanes cannot be compiled.
     """
+    _check_lanes(lanes)
     if not runs:
         return []
     lanes = default_lanes() if lanes is None else lanes
@@ -224,6 +227,13 @@ def run_lanes(runs: Sequence[PreparedRun], *, lanes: int | None = None, compiled
                 meta["rk4_error"] = errors[lane]
             results.append(SimResult(input_column(W, 0).copy(), signals, meta))
     return results
+
+
+def _check_lanes(lanes) -> None:
+    """SimulationError unless ``lanes`` is None or a positive integer."""
+    if lanes is not None and (isinstance(lanes, bool) or not isinstance(lanes, int) or lanes < 1):
+        raise SimulationError(f"lanes must be a positive integer (trajectories per compiled step) or None (this "
+                              f"processor's measured count), got {lanes!r}")
 
 
 @memoized(16)
