@@ -89,7 +89,7 @@ class ResultStore:
         claim_folder(self.folder, f"the campaign {name}", "report", force, writer=("campaign", name))
         record = self._record()
         self.files = dict(record.get("files") or {}) if isinstance(record, dict) else {}
-        self._written: dict[Path, pa.Table] = {}  # the chunks this store wrote, as read back: not read again
+        self._written: dict[Path, pa.Table] = {}  # the chunks this store wrote: not read back
 
     def create(self) -> None:
         """Make the folder, its chunks/ and its record (after every check, before the first run: a campaign
@@ -134,9 +134,9 @@ class ResultStore:
     def write_chunk(self, rows: list[dict], kinds: dict[str, str]) -> Path:
         """Write the rows of one finished chunk (recorded first, then written to .part and renamed)."""
         buffer = io.BytesIO()
-        pq.write_table(to_table(rows, kinds), buffer)
+        table = to_table(rows, kinds)
+        pq.write_table(table, buffer)
         data = buffer.getvalue()
-        table = pq.read_table(pa.BufferReader(data))  # as results() would read the file back
         ids = hashlib.sha256("\n".join(row["run_id"] for row in rows).encode()).hexdigest()[:16]
         rel = f"chunks/chunk-{ids}.parquet"
         self.files[rel] = hashlib.sha256(data).hexdigest()
