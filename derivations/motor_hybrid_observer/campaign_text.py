@@ -12,6 +12,7 @@ __all__ = ["campaign_section", "designed_against_measured", "long_healthy", "lim
 
 WHO = {"hybrid": "hybrid, z sigma at 1 /h", "hybrid_study": "hybrid, study's threshold",
        "luenberger_fd": "Luenberger, z sigma at 1 /h"}
+CONFIRMING_HOURS = 10.0  # fault-free hours a noise level needs before its rate is set against the designed one
 GROWING = ("incipient", "ramp", "drift")  # the fault labels' words for a fault that grows after its onset
 
 
@@ -46,10 +47,18 @@ def _noise(noise: str) -> str:
     return f"{noise} (the study's)" if round(times, 9) == 1 else f"{noise} ({times:.3g} x)"
 
 
+def _above(rates: dict[str, tuple[float, float]], designed: float) -> tuple[list[str], list[str]]:
+    """(noise levels measured above ``designed`` per hour over at least CONFIRMING_HOURS, levels with fewer
+    hours) of noise level -> (fault-free hours, false alarms per hour)."""
+    return ([noise for noise, (hours, rate) in rates.items() if hours >= CONFIRMING_HOURS and rate > designed],
+            [noise for noise, (hours, _) in rates.items() if hours < CONFIRMING_HOURS])
+
+
 def designed_against_measured(c: dict) -> str:
-    """Each detector's designed false-alarm rate beside what the noise levels of 10 fault-free hours or more
-    measured; the shorter levels named as too short to confirm it."""
-    long_enough = {noise: r for noise, r in c["healthy_by_noise"].items() if r["hybrid"]["healthy_hours"] >= 10.0}
+    """Each detector's designed false-alarm rate beside what the noise levels of CONFIRMING_HOURS fault-free
+    hours or more measured; the shorter levels named as too short to confirm it."""
+    long_enough = {noise: r for noise, r in c["healthy_by_noise"].items()
+                   if r["hybrid"]["healthy_hours"] >= CONFIRMING_HOURS}
     short = [f"{noise} rad/s ({r['hybrid']['healthy_hours']:.3g} h)" for noise, r in c["healthy_by_noise"].items()
              if noise not in long_enough]
     parts = []
@@ -59,12 +68,13 @@ def designed_against_measured(c: dict) -> str:
         if designed is None:
             parts.append(f"{WHO[d]} (a given threshold: no designed rate): {measured}")
             continue
-        above = [noise for noise, r in long_enough.items() if r[d]["false_alarms_per_hour"] > designed]
+        above, _ = _above({noise: (r["hybrid"]["healthy_hours"], r[d]["false_alarms_per_hour"])
+                           for noise, r in long_enough.items()}, designed)
         verdict = f"above it at {', '.join(above)} rad/s" if above else "none above it"
         parts.append(f"{WHO[d]} (designed for {designed:g} per hour): {measured}; {verdict}")
-    return ("Designed and measured false alarms per hour, over the noise levels with at least 10 fault-free "
-            "hours: " + ". ".join(parts) + "." + (f" Too few fault-free hours to confirm a rate at "
-                                                   f"{', '.join(short)}." if short else ""))
+    too_few = f" Too few fault-free hours to confirm a rate at {', '.join(short)}." if short else ""
+    return (f"Designed and measured false alarms per hour, over the noise levels with at least "
+            f"{CONFIRMING_HOURS:g} fault-free hours: " + ". ".join(parts) + "." + too_few)
 
 
 def campaign_section(c: dict) -> str:
@@ -121,8 +131,7 @@ def long_healthy(tb: dict) -> str:
     levels, designed = tb["long_healthy"]["levels"], tb["false_alarms_per_hour_designed"]
     measured = "; ".join(f"{noise} rad/s: {v['false_alarms']} in {v['hours']:.3g} h ({v['per_hour']:.3g} per hour)"
                          for noise, v in levels.items())
-    above = [noise for noise, v in levels.items() if v["hours"] >= 10.0 and v["per_hour"] > designed]
-    short = [noise for noise, v in levels.items() if v["hours"] < 10.0]
+    above, short = _above({noise: (v["hours"], v["per_hour"]) for noise, v in levels.items()}, designed)
     verdict = (f"above the designed {designed:g} per hour at {', '.join(above)} rad/s" if above
                else f"none above the designed {designed:g} per hour")
     return (f"In its long healthy runs (`campaign_torque_balance.toml`: 20 N m, Rr +100 % over the first 10 s, "

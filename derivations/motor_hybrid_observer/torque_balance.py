@@ -124,15 +124,19 @@ def loaded_plant(load: float = LOAD) -> System:
                   constants=motor.constants)
 
 
+def _estimate_run(result, plant: System, sigma_omega: float, sigma_i: float) -> Estimate:
+    """:func:`estimate` on a simulated run of ``plant`` held at its operating-point input u_op."""
+    y = np.column_stack([result["y"][n] for n in plant.y.names])
+    return estimate(result.t, y, np.tile(plant.u_op, (result.t.size, 1)), plant, sigma_omega, sigma_i)
+
+
 def healthy_metrics(scenario, result, events) -> dict:
     """The campaign hook of the long healthy runs (``campaign_torque_balance.toml``): the estimator on the
     run's measured outputs, told the scenario's sensor noise; ``tb_false_alarms`` (0 or 1: a detection or an
     unexplained torque, the run being fault-free) over ``tb_judged_s`` (s from ``START_UNTIL``)."""
     plant = scenario.plant  # loaded_plant(load): the motor's constants at the scenario's load
     noise = {plant.y.names[f.channel]: f.value for f in scenario.sensor_faults if f.kind == "noise"}
-    y = np.column_stack([result["y"][n] for n in plant.y.names])
-    u = np.tile(plant.u_op, (result.t.size, 1))
-    e = estimate(result.t, y, u, plant, noise["omega_m"], noise["i_sq"])
+    e = _estimate_run(result, plant, noise["omega_m"], noise["i_sq"])
     return {"tb_detected_at": e.detected_at, "tb_unexplained_at": e.unexplained_at,
             "tb_false_alarms": int(e.detected_at is not None or e.unexplained_at is not None),
             "tb_judged_s": float(result.t[-1] - START_UNTIL)}
@@ -155,9 +159,7 @@ def loaded_run(rr_rise: float = 1.0, load_step: float = 0.0, noise_factor: float
     supply = open_loop("supply", [0.0], [plant.u_op], publishes=plant.u.names)
     result = simulate_system(plant, [supply], duration=duration, dt=DT, x0=plant.x_op + INITIAL_OFFSET,
                              sensor_faults=tuple(faults), d=d, seed=seed, compiled=True)
-    y = np.column_stack([result["y"][n] for n in plant.y.names])
-    u = np.tile(plant.u_op, (result.t.size, 1))
-    est = estimate(result.t, y, u, plant, noise_factor * NOISE["omega_m"], noise_factor * NOISE["i_sq"])
+    est = _estimate_run(result, plant, noise_factor * NOISE["omega_m"], noise_factor * NOISE["i_sq"])
     return {"estimate": est, "fault": fault, "rr_rise": rr_rise, "load_step": load_step, "noise_factor": noise_factor,
             "onset": onset}
 
