@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from uvsym.campaign.limits import channel_limits, false_alarm_rates, false_alarm_table, limits_table
+from uvsym.campaign.limits import channel_limits, every_size_from, false_alarm_rates, false_alarm_table, limits_table
 from uvsym.errors import CampaignError
 
 
@@ -57,3 +57,9 @@ def test_a_size_function_measures_factors_from_one_and_leaves_out_what_it_gives_
                             else None)
     assert [(item["kind"], [s for s, _, _ in item["sizes"]]) for item in limits] == [("proportional",
                                                                                       [pytest.approx(0.2), 0.5])]
+
+
+def test_every_size_from_is_the_smallest_size_above_the_last_that_fails():
+    assert every_size_from([(1.0, True), (2.0, False), (3.0, True), (4.0, True)]) == 3.0
+    assert every_size_from([(1.0, True), (2.0, True)]) == 1.0
+    assert every_size_from([(1.0, True), (2.0, False)]) is None and every_size_from([]) is None

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from uvsym.campaign import load_campaign, run_campaign
-from uvsym.campaign.limits import channel_limits, limits_table
+from uvsym.campaign.limits import NONE_SEEN_95, channel_limits, every_size_from, limits_table
 from uvsym.campaign.summary import detector_rates
 from uvsym.progress import ProgressBar
 from uvsym.report import limits_block, markdown_table
@@ -173,16 +173,6 @@ Every per-run row is in [campaign_results.csv](campaign_results.csv).
 """
 
 
-def _every_run_from(by_size: dict, figure: str) -> float | None:
-    """The smallest size (a key of ``by_size``) from which ``figure`` is 1 at every larger size too."""
-    found = None
-    for size in sorted(by_size, key=float, reverse=True):
-        if by_size[size][figure] != 1.0:
-            break
-        found = float(size)
-    return found
-
-
 def _delays(by_size: dict, seen: float | None, unit: str) -> str:
     """The median detection delay at the size ``seen`` (from which every rotor is detected) and at the largest."""
     ends = ([] if seen is None else [f"{seen:g}"]) + [max(by_size, key=float)]
@@ -204,7 +194,7 @@ def _designed_rate(healthy: dict, proved: bool = True) -> str:
         return (f"{alarms} false alarms in {hours:.3g} h ({_cell(healthy['false_alarms_per_hour'])} per hour): "
                 f"**not {zero}**")
     return (f"0 false alarms in {hours:.3g} h, {agrees}; on their own these hours bound the rate only below "
-            f"{np.log(20) / hours:.2g} per hour (95 %, no event in a Poisson count)")
+            f"{NONE_SEEN_95 / hours:.2g} per hour (95 %, no event in a Poisson count)")
 
 
 def _alarms_once(healthy: dict) -> bool:
@@ -248,7 +238,7 @@ def limits_section(c: dict, bands_proved: int, observers: int) -> str:
     seen = {kind: [item["seen_from"] for item in items] for kind, items in limits.items()}
     every = {kind: None if not s or None in s else max(s) for kind, s in seen.items()}  # every rotor detected
     runs = max(n for items in limits.values() for item in items for _, n, _ in item["sizes"])
-    isolated = _every_run_from(sizes, "correct_isolation")
+    isolated = every_size_from(sorted((float(k), v["correct_isolation"] == 1.0) for k, v in sizes.items()))
     below = [v for k, v in sizes.items() if (isolated is None or float(k) < isolated) and v["detection_probability"]]
     ambiguous = _cell(sum(v["ambiguous"] * v["runs"] for v in below)
                       / sum(v["detection_probability"] * v["runs"] for v in below)) if below else "-"

@@ -6,13 +6,12 @@ the measured limits read off them."""
 from __future__ import annotations
 
 import csv
-import math
 import tempfile
 from pathlib import Path
 
 from derivations.usv_fukf_mmae.scenario import parsed
 from uvsym.campaign import load_campaign, run_campaign
-from uvsym.campaign.limits import channel_limits, limits_table
+from uvsym.campaign.limits import NONE_SEEN_95, channel_limits, limits_table
 from uvsym.campaign.summary import detector_names, detector_rates
 from uvsym.progress import ProgressBar
 from uvsym.report import limits_block, markdown_table
@@ -22,7 +21,6 @@ __all__ = ["CAMPAIGN", "run_study_campaign", "campaign_section", "limits_section
 CAMPAIGN = Path(__file__).with_name("campaign.toml")
 RATES = ("runs", "fault_runs", "detection_probability", "missed_detections", "median_detection_delay_s",
          "correct_isolation", "median_size_error_rel", "false_alarms", "healthy_hours", "false_alarms_per_hour")
-NONE_SEEN = -math.log(0.05)  # none seen in H hours: a Poisson rate below NONE_SEEN / H per hour at 95 %
 SIZE_TOLERANCE = 0.05  # |identified - true| of a delivered fraction that counts as badly sized
 ROW_COLUMNS = ("case", "true_actuator", "true_kind", "true_value", "onset_s", "noise.x", "status", "error")
 PER_DETECTOR = ("detected", "detection_delay_s", "isolated_target", "identified_value", "false_alarms", "clear_delay_s",
@@ -207,7 +205,7 @@ def _alarms_by_noise(c: dict) -> str:
     detectors, designed = list(c["detectors"]), c["designed_false_alarms_per_hour"]
 
     def cell(per: dict) -> str:
-        bound = f" (< {NONE_SEEN / per['healthy_hours']:.3g} /h, 95 %)" if not per["false_alarms"] else ""
+        bound = f" (< {NONE_SEEN_95 / per['healthy_hours']:.3g} /h, 95 %)" if not per["false_alarms"] else ""
         return f"{per['false_alarms']} in {_f(per['healthy_hours'])} h: {_f(per['false_alarms_per_hour'])} /h{bound}"
 
     rows = [["designed"] + ["none (a posterior threshold)" if designed[d] is None else f"at most {designed[d]:g} /h"
@@ -303,7 +301,7 @@ def limits_section(c: dict) -> str:
                 continue
             if rate > designed[d]:
                 above[d].append(f"{noise} ({_f(rate)} /h)")
-            elif not per[d]["false_alarms"] and NONE_SEEN / hours > designed[d]:
+            elif not per[d]["false_alarms"] and NONE_SEEN_95 / hours > designed[d]:
                 unconfirmed[d].append(f"{noise} ({_f(hours)} h)")
     above, unconfirmed = (_grouped({d: ", ".join(levels) for d, levels in found.items()})
                           for found in (above, unconfirmed))

@@ -14,11 +14,15 @@ From the rows of :func:`uvsym.campaign.run_campaign` (dicts with the columns of
 
 from __future__ import annotations
 
+import math
 import statistics
 
 from uvsym.errors import CampaignError
 
-__all__ = ["channel_limits", "false_alarm_rates", "limits_table", "false_alarm_table"]
+__all__ = ["NONE_SEEN_95", "channel_limits", "every_size_from", "false_alarm_rates", "limits_table",
+           "false_alarm_table"]
+
+NONE_SEEN_95 = math.log(20.0)  # no event in H hours: a Poisson rate below NONE_SEEN_95 / H per hour at 95 %
 
 
 def _column(rows: list[dict], detector: str | None, metric: str):
@@ -49,17 +53,24 @@ def channel_limits(rows: list[dict], detector: str | None = None, cases=None, si
     limits = []
     for (channel, kind), by_size in sorted(groups.items()):
         sizes = [(size, len(runs), sum(bool(detected(r)) for r in runs)) for size, runs in sorted(by_size.items())]
-        seen_from = None
-        for size, runs, hits in reversed(sizes):
-            if hits < runs:
-                break
-            seen_from = size
+        seen_from = every_size_from([(size, hits == runs) for size, runs, hits in sizes])
         missed = [size for size, runs, hits in sizes if hits < runs]
         delays = [delay(r) for runs in by_size.values() for r in runs if detected(r) and delay(r) is not None]
         limits.append({"channel": channel, "kind": kind, "sizes": sizes, "seen_from": seen_from,
                        "missed_up_to": max(missed) if missed else None,
                        "median_delay_s": statistics.median(delays) if delays else None})
     return limits
+
+
+def every_size_from(sizes) -> float | None:
+    """The smallest size from which every larger size tried holds too, of (size, holds) pairs in ascending
+    size; None when the largest does not hold."""
+    found = None
+    for size, holds in reversed(list(sizes)):
+        if not holds:
+            break
+        found = size
+    return found
 
 
 def false_alarm_rates(rows: list[dict], noise_field: str, detector: str | None = None) -> list[dict]:
