@@ -15,12 +15,16 @@ writes ``benchmarks/results/zonotope.json``:
   derivation's own design; ``step_with_maps_us`` the same keeping the reductions' coefficient
   maps (what the Monte Carlo enclosure check needs).
 
-Times are medians of repeated batches within this one run (the machine may be shared).
+The reductions are timed as the median of ``TURNS * BLOCK`` single calls per contender, the
+contenders taking turns in blocks of ``BLOCK`` calls (the machine's speed drifts by tens of percent
+within a second here; taking turns exposes each contender to the same drift, and the median leaves
+out the first calls of a block, cold after another contender's). The band step is the median of three whole runs.
 """
 
 from __future__ import annotations
 
 import sys
+import time
 import warnings
 from pathlib import Path
 
@@ -39,6 +43,7 @@ RESULTS = Path(__file__).resolve().parent / "results" / "zonotope.json"
 TARGETS = {"speedup_vs_pypolycontain_min": 5}
 DIMENSION, GENERATORS_IN, GENERATORS_OUT = 6, 200, 30
 BAND_SAMPLES = 300
+TURNS, BLOCK = 100, 100
 
 
 def median_us(call, repeat: int = 7, number: int = 200) -> float:
@@ -46,21 +51,36 @@ def median_us(call, repeat: int = 7, number: int = 200) -> float:
     return median_time(call, repeat, number) * 1e6
 
 
-def pypolycontain_us(center: np.ndarray, G: np.ndarray) -> dict | None:
-    """pypolycontain's boxing and PCA reductions of the same zonotope, or None when it is not installed."""
+def turns_us(calls: dict) -> dict:
+    """name -> median microseconds of ``TURNS * BLOCK`` single calls of each callable, the callables taking
+    turns in blocks of ``BLOCK`` calls (each single call timed)."""
+    clock, names = time.perf_counter, list(calls)
+    times = np.empty((len(names), TURNS, BLOCK))
+    for turn in range(TURNS):
+        for k, name in enumerate(names):
+            call, row = calls[name], times[k, turn]
+            for i in range(BLOCK):
+                started = clock()
+                call()
+                row[i] = clock() - started
+    return {name: float(np.median(times[k]) * 1e6) for k, name in enumerate(names)}
+
+
+def pypolycontain_calls(center: np.ndarray, G: np.ndarray) -> dict:
+    """pypolycontain's boxing and PCA reductions of the same zonotope as calls, or {} when it is not installed."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             import pypolycontain as pp
     except ImportError:
-        return None
+        return {}
     z = pp.zonotope(x=center.reshape(-1, 1), G=G)
-    reduced = pp.operations.boxing_order_reduction(z, GENERATORS_OUT / DIMENSION)
+    order = GENERATORS_OUT / DIMENSION
+    reduced = pp.operations.boxing_order_reduction(z, order)
     if reduced.G.shape[1] != GENERATORS_OUT:
         raise RuntimeError(f"pypolycontain kept {reduced.G.shape[1]} generators, not {GENERATORS_OUT}")
-    order = GENERATORS_OUT / DIMENSION
-    return {"boxing": median_us(lambda: pp.operations.boxing_order_reduction(z, order)),
-            "pca": median_us(lambda: pp.operations.pca_order_reduction(z, order))}
+    return {"pypolycontain_boxing": lambda: pp.operations.boxing_order_reduction(z, order),
+            "pypolycontain_pca": lambda: pp.operations.pca_order_reduction(z, order)}
 
 
 def main() -> dict:
@@ -68,13 +88,11 @@ def main() -> dict:
     center, G = rng.normal(size=DIMENSION), rng.normal(size=(DIMENSION, GENERATORS_IN))
     Z = Zonotope(center, G)
     reduce(Z, GENERATORS_OUT)  # builds the compiled kernel once
-    # as the README calls it, then with the map
-    reduce_us = {method: median_us(lambda m=method: reduce(Z, GENERATORS_OUT, m)) for method in METHODS}
-    reduce_us |= {f"{method}_with_map": median_us(lambda m=method: reduce(Z, GENERATORS_OUT, m, coefficients=True))
-                  for method in METHODS}
-    theirs = pypolycontain_us(center, G)
-    baseline = None if theirs is None else theirs["boxing"]
-    reduce_us |= {f"pypolycontain_{k}": v for k, v in (theirs or {}).items()}
+    calls = {method: (lambda m=method: reduce(Z, GENERATORS_OUT, m)) for method in METHODS}  # as the README calls it
+    calls |= {f"{method}_with_map": (lambda m=method: reduce(Z, GENERATORS_OUT, m, coefficients=True))
+              for method in METHODS}
+    reduce_us = turns_us(calls | pypolycontain_calls(center, G))
+    baseline = reduce_us.get("pypolycontain_boxing")
     d = design()
     n = d.plant.x.size
 

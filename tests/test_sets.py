@@ -151,6 +151,24 @@ def test_compiled_box_reduction_equals_the_numpy_path(method, monkeypatch):
     assert reduce(Z, 30, method, coefficients=False).coefficients is None
 
 
+@pytest.mark.parametrize("method", ["girard", "combastel"])
+@pytest.mark.parametrize("n, m, generators", [(3, 40, 3), (3, 40, 39), (6, 200, 30), (8, 9, 8), (1, 17, 5)])
+def test_compiled_box_reduction_breaks_score_ties_as_the_numpy_path(method, n, m, generators, monkeypatch):
+    """Integer generators in {-2..2} tie in score again and again (and some are zero): the kernel's selection
+    must replace the lower index of a tie, as the numpy path's stable sort does, down to the last column."""
+    from uvsym.sets import kernel, reduction
+
+    if kernel.box_reduce(np.eye(2), 2, False) is None:
+        pytest.skip("no C compiler: only the numpy path exists")
+    G = np.random.default_rng(n * m + generators).integers(-2, 3, size=(n, m)).astype(float)
+    Z = Zonotope(np.zeros(n), G)
+    compiled = reduce(Z, generators, method, coefficients=True)
+    monkeypatch.setattr(reduction, "box_reduce", lambda *args, **kwargs: None)
+    reference = reduce(Z, generators, method, coefficients=True)
+    np.testing.assert_array_equal(compiled.zonotope.generators, reference.zonotope.generators)
+    np.testing.assert_array_equal(compiled.coefficients, reference.coefficients)
+
+
 def test_untracked_propagation_has_the_same_bands_and_refuses_coefficients():
     args = ([[0.5, 0.1], [0.0, 0.3]], np.eye(2), box([-1, -1], [1, 1]), box([-0.1, -0.1], [0.1, 0.1]), 20, 4)
     tracked, untracked = propagate(*args), propagate(*args, track=False)
