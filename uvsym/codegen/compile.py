@@ -122,19 +122,20 @@ _ROLL = """
 int {name}_roll(const casadi_real* z0, const casadi_real* W, casadi_real* z_end, casadi_real* O, long N) {{
   static casadi_real w[{name}_SZ_W > 0 ? {name}_SZ_W : 1];
   static casadi_int iw[{name}_SZ_IW > 0 ? {name}_SZ_IW : 1];
-  casadi_real z[{n_z}], z_next[{n_z}];
+  casadi_real a[{n_z}], b[{n_z}];
+  casadi_real *z = a, *z_next = b, *swap;
   const casadi_real* arg[{name}_SZ_ARG];
   casadi_real* res[{name}_SZ_RES];
-  memcpy(z, z0, sizeof z);
+  memcpy(z, z0, sizeof a);
   for (long k = 0; k < N; ++k) {{
     arg[0] = z;
     arg[1] = W + k * {n_w};
     res[0] = z_next;
     res[1] = O + k * {n_out};
     if ({name}(arg, res, iw, w, 0)) return 1;
-    memcpy(z, z_next, sizeof z);
+    swap = z; z = z_next; z_next = swap;  /* the next state becomes the state: no copy */
   }}
-  memcpy(z_end, z, sizeof z);
+  memcpy(z_end, z, sizeof a);
   return 0;
 }}
 """
@@ -223,13 +224,14 @@ __attribute__((noinline)) static void {name}_body(const double* restrict in0, co
 {body}
 }}
 int {name}_roll(const double* z0, const double* W, double* z_end, double* O, long N) {{
-  double z[{n_z}], z_next[{n_z}];
-  memcpy(z, z0, sizeof z);
+  double a[{n_z}], b[{n_z}];
+  double *z = a, *z_next = b, *swap;
+  memcpy(z, z0, sizeof a);
   for (long k = 0; k < N; ++k) {{
     {name}_body(z, W + k * {n_w}, z_next, O + k * {n_out});
-    memcpy(z, z_next, sizeof z);
+    swap = z; z = z_next; z_next = swap;  /* the next state becomes the state: no copy */
   }}
-  memcpy(z_end, z, sizeof z);
+  memcpy(z_end, z, sizeof a);
   return 0;
 }}
 """
