@@ -10,7 +10,7 @@ import casadi as ca
 import numpy as np
 
 __all__ = ["is_casadi", "stack", "block", "matvec", "entries", "rk4", "rk4_stage_times", "as_column",
-           "has_nan_constant"]
+           "has_nan_constant", "balanced_sum"]
 
 _CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
 
@@ -57,6 +57,19 @@ def entries(vector, n: int, name: str = "vector"):
     if array.size != n:
         raise ValueError(f"{name} must have {n} entries, got {array.size}")
     return list(array)
+
+
+def balanced_sum(vector):
+    """The sum of a column vector's (n,) entries as a balanced tree of additions: the value of ``sum1`` to
+    rounding, but ceil(log2 n) additions deep instead of n - 1, so straight-line generated C runs the
+    additions side by side instead of waiting on each one (a dot product of 70 terms: 7 latencies, not 69)."""
+    if vector.shape[1] != 1:
+        raise ValueError(f"balanced_sum sums a column vector, got shape {vector.shape}")
+    n = vector.shape[0]
+    if n <= 2:
+        return ca.sum1(vector)
+    half = (n + 1) // 2
+    return balanced_sum(vector[:half]) + balanced_sum(vector[half:])
 
 
 def rk4(ode, s, h: float, steps: int, *args, t=0.0):

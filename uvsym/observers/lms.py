@@ -51,6 +51,7 @@ import numpy as np
 from uvsym.errors import ObserverError, StepSizeWarning
 from uvsym.observers.base import Observer, check_name, observer
 from uvsym.observers.lms_supervisor import DECISION_STATE, double_criterion
+from uvsym.symbolic import balanced_sum
 from uvsym.systems.signals import Signals, signals
 
 __all__ = ["lms_step", "lms_monitor", "mu_bound", "check_mu"]
@@ -88,17 +89,18 @@ def check_mu(mu: float, order: int, input_power: float, what: str = "mu") -> flo
     return bound
 
 
-def lms_step(order: int) -> ca.Function:
+def lms_step(order: int, balanced: bool = False) -> ca.Function:
     """The bare LMS-FIR step (paper eqs. 3-5), ``lms_step(C, U, target, u, mu) -> (C_next, U_next, d, e)``.
 
     C (M,) weights, U (M,) the regression vector ``[u_{k-1}, ..., u_{k-M}]``, target the sample
     the filter predicts (``y - r``), u the new input u_k, mu the step; ``d = C . U``, ``e = d -
     target``, ``C_next = C - 2 mu e U``, ``U_next = [u_k, u_{k-1}, ..., u_{k-M+1}]``. Built on MX, so its
-    generated C runs vector loops; called on SX (inside the monitor's step) it expands.
+    generated C runs vector loops; called on SX (inside the monitor's step) it expands. balanced: d as a
+    balanced tree of additions (:func:`uvsym.symbolic.balanced_sum`), for straight-line code.
     """
     M = _positive_int(order, "order M", "lms_step")
     C, U, target, u, mu = ca.MX.sym("C", M), ca.MX.sym("U", M), ca.MX.sym("target"), ca.MX.sym("u"), ca.MX.sym("mu")
-    d = ca.dot(C, U)
+    d = balanced_sum(C * U) if balanced else ca.dot(C, U)
     e = d - target
     return ca.Function("lms_fir_step", [C, U, target, u, mu], [C - (2 * mu * e) * U, ca.vertcat(u, U)[:M], d, e],
                        ["C", "U", "target", "u", "mu"], ["C_next", "U_next", "d", "e"])
@@ -128,7 +130,7 @@ def lms_monitor(measured: Signals, regressor: Signals, *, order: int, mu: float,
     if n < 2:
         raise ObserverError(f"{name}: window n must be at least 2 samples (R needs a spread), got {n}")
     decide = double_criterion(_positive_int(confirm, "confirm", name))
-    lms = lms_step(M)
+    lms = lms_step(M, balanced=True)  # the step expands to straight-line code: its sums as trees
     hold = _positive_int(hold, "hold", name)
     p0 = [_positive(mu, "mu", name), _positive(eps0, "eps0", name), _positive(r0, "r0", name)]
     _positive(dt, "sample period dt", name)
@@ -162,17 +164,18 @@ def lms_monitor(measured: Signals, regressor: Signals, *, order: int, mu: float,
         mu_, eps0_, r0_ = p[0], p[1], p[2]
         offset = u[1] if reference is not None else 0.0
         C_next, U_next, d, e = lms(C, U, y[0] - offset, u[0], mu_)
-        W_next = ca.vertcat(W[1:], ca.sum1(C))
+        W_next = ca.vertcat(W[1:], balanced_sum(C))
         count_next = ca.fmin(count + 1, n)
-        mean = ca.sum1(W_next) / n
-        var = ca.sum1((W_next - mean) ** 2) / n
+        mean = balanced_sum(W_next) / n
+        var = balanced_sum((W_next - mean) ** 2) / n
         full = ca.logic_and(count_next >= n, var > 0)
         R = ca.if_else(full, (W_next[-1] - mean) ** 2 / ca.if_else(var > 0, var, 1.0), 0.0)
         above_next = ca.if_else(R > r0_, ca.fmin(above + 1, hold), 0.0)
         alarm_e, alarm_r = e ** 2 > eps0_, above_next >= hold
         decision_next, snapshot, released = decide(decision, alarm_e, alarm_r)
         Cf_next = ca.if_else(snapshot, C, Cf)
-        substitute = offset + ca.if_else(ca.logic_and(decision_next[0], ca.logic_not(snapshot)), ca.dot(Cf, U), d)
+        frozen_now = ca.logic_and(decision_next[0], ca.logic_not(snapshot))
+        substitute = offset + ca.if_else(frozen_now, balanced_sum(Cf * U), d)
         s_next = ca.vertcat(C_next, U_next, W_next, Cf_next, decision_next, count_next, above_next)
         out = ca.vertcat(offset + d, substitute, e, e ** 2, R, alarm_e, alarm_r, decision_next[0],
                          decision_next[2], released)
