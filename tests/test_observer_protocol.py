@@ -458,5 +458,59 @@ def test_run_keeping_only_the_final_state_gives_the_same_outputs_and_last_state(
     assert last.shape == (1, obs.state.size) and outputs.shape == OUT.shape
     np.testing.assert_array_equal(outputs, OUT)
     np.testing.assert_array_equal(last[0], S[-1])
-    with pytest.raises(ObserverError, match="states must be 'all' or 'final'"):
+    with pytest.raises(ObserverError, match="states must be 'all', 'final' or a sequence of state names"):
         obs.run(Y, U, states="last")
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_run_keeping_named_state_entries_gives_those_columns_of_the_full_history(compiled):
+    """states=[names]: S (N + 1, k), the named columns of the full run's S in the order given, from s0, and the
+    same outputs, on both paths (the C loop writes only those entries); an unknown name, an empty selection and
+    a number are refused, the unknown one named."""
+    import numpy as np
+    from problems import double_integrator
+
+    from uvsym.codegen.compile import find_compiler
+    from uvsym.errors import ObserverError
+    from uvsym.observers.ukf import ukf
+
+    if compiled and find_compiler() is None:
+        pytest.skip("no C compiler")
+    obs = ukf(double_integrator(outputs=("pos",)), dt=0.1, Q=np.diag([1e-6, 1e-4]), R=1e-4, P0=np.eye(2))
+    N = 2500
+    Y, U = np.random.default_rng(4).normal(scale=0.01, size=(N, 1)), np.zeros((N, 1))
+    S, OUT = obs.run(Y, U, compiled=compiled)
+    names = [obs.state.names[-1], obs.state.names[0]]
+    kept, outputs = obs.run(Y, U, compiled=compiled, states=names)
+    assert kept.shape == (N + 1, 2)
+    np.testing.assert_array_equal(kept, S[:, [obs.state.size - 1, 0]])
+    np.testing.assert_array_equal(outputs, OUT)
+    with pytest.raises(ObserverError, match="no state named 'nosuch'"):
+        obs.run(Y, U, states=[names[0], "nosuch"])
+    with pytest.raises(ObserverError, match="at least one state entry"):
+        obs.run(Y, U, states=[])
+    with pytest.raises(ObserverError, match="a sequence of state names"):
+        obs.run(Y, U, states=3)
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_a_stateless_observer_keeps_one_empty_state_row_per_sample(compiled):
+    """An observer without state entries (a static map of its measurement): states="all" gives S (N + 1, 0)
+    and "final" S (1, 0), on both paths, with the same outputs."""
+    import numpy as np
+
+    from uvsym.codegen.compile import find_compiler
+    from uvsym.observers.base import observer
+    from uvsym.systems import signals
+
+    if compiled and find_compiler() is None:
+        pytest.skip("no C compiler")
+    doubler = observer("doubler", step=lambda s, y, u, p: (s, [2 * y[0]]), state=signals(group="state"),
+                       reads_y=signals(("x", "m", ""), group="output"), reads_u=signals(group="input"),
+                       publishes=signals(("x2", "m", "twice x")), dt=0.1)
+    Y = np.arange(30.0)[:, None]
+    S, OUT = doubler.run(Y, np.zeros((30, 0)), compiled=compiled)
+    last, published = doubler.run(Y, np.zeros((30, 0)), compiled=compiled, states="final")
+    assert S.shape == (31, 0) and last.shape == (1, 0)
+    np.testing.assert_array_equal(OUT[:, 0], 2 * Y[:, 0])
+    np.testing.assert_array_equal(published, OUT)

@@ -26,6 +26,7 @@ scalar or compiled; it exports to C (:mod:`uvsym.codegen`); a report renders its
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -35,7 +36,7 @@ import numpy as np
 
 from uvsym.checked import checked
 from uvsym.codegen.cache import memoized
-from uvsym.errors import ObserverError
+from uvsym.errors import ObserverError, UnknownNameError
 from uvsym.symbolic import as_column, has_nan_constant
 from uvsym.systems.signals import Signals
 
@@ -130,12 +131,14 @@ class Observer:
         return s0
 
     def run(self, Y, U, p=None, s0=None, *, missing_y: bool = False, compiled: bool | None = None,
-            states: str = "all") -> tuple[np.ndarray, np.ndarray]:
+            states="all") -> tuple[np.ndarray, np.ndarray]:
         """Run on recorded data (open loop): Y (N, n_y), U (N, n_u) -> (S (N + 1, n_s), OUT (N, n_out)).
 
         states: ``"all"`` returns every state S (N + 1, n_s), from s0; ``"final"`` only the last one, S (1, n_s),
         which spares the history's memory where the outputs are what is wanted (the LMS monitor's state holds
-        its weights and regressor window, 235 numbers a sample).
+        its weights and regressor window, 235 numbers a sample); a sequence of state names (or a
+        :class:`Signals` of them) the history of those entries only, S (N + 1, k) in the order given (the LMS
+        monitor's weights ``C_1 .. C_M``: what an adaptive-filter library returns beside its outputs).
         missing_y: Y may hold NaN (an estimator that skips the update of such a sample, e.g. a
         Kalman filter); the initial state is then taken from the first complete measurement.
         compiled: the steps in a compiled C loop (:func:`uvsym.codegen.compile.compile_roll`, IEEE flags:
@@ -152,8 +155,9 @@ class Observer:
         if bad_y or not np.all(np.isfinite(U)):
             raise ObserverError(f"{self.name}: inputs U must be finite and measurements Y finite"
                                 + (" or NaN" if missing_y else ""))
-        if states not in ("all", "final"):
-            raise ObserverError(f"{self.name}: states must be 'all' or 'final', got {states!r}")
+        kept_entries = self._kept_entries(states)
+        final, every = (isinstance(states, str) and states == choice for choice in ("final", "all"))
+        picked = list(kept_entries)
         p = self.parameters(p)
         first = next((k for k in range(len(Y)) if np.all(np.isfinite(Y[k]))), 0)
         s = self.initial_state(np.nan_to_num(Y[first]), U[0], p) if s0 is None else \
@@ -162,42 +166,73 @@ class Observer:
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
         roll = None
         if compiled or (compiled is None and len(Y) >= COMPILE_FROM and not missing_y):
-            roll = _compiled_roll(self.step, required=bool(compiled), history=states == "all")
+            roll = _compiled_roll(self.step, bool(compiled), None if every else kept_entries)
         if roll is not None:
             W = np.ascontiguousarray(np.column_stack([Y, U, np.broadcast_to(p, (len(Y), p.size))]))
             n_out = self.publishes.size
-            if states == "final":
+            if final:
                 outputs = np.empty((len(Y), n_out))
                 return np.asarray(roll(s, W, outputs)).reshape(1, -1), outputs
-            rows = np.empty((len(Y) + 1, n_out + self.state.size))  # rows [out; s]: S and OUT views, no copy
-            rows[0, :n_out], rows[0, n_out:] = np.nan, s
+            rows = np.empty((len(Y) + 1, n_out + len(kept_entries)))  # rows [out; kept s]: S and OUT views, no copy
+            rows[0, :n_out], rows[0, n_out:] = np.nan, s[picked]
             roll(s, W, rows[1:])
             return rows[:, n_out:], rows[1:, :n_out]
-        kept, outputs = [s[None, :]], []
+        kept, outputs, last = [s[None, :] if every or final else s[None, picked]], [], s
         for start in range(0, len(Y), RUN_CHUNK):  # fixed chunks: the cost is linear in N (one mapaccum(N) is not)
             k = min(RUN_CHUNK, len(Y) - start)
-            S, OUT = _rolled(self.step, k)(kept[-1][-1], Y[start:start + k].T, U[start:start + k].T, p)
+            S, OUT = _rolled(self.step, k)(last, Y[start:start + k].T, U[start:start + k].T, p)
             S = np.asarray(S).T.reshape(k, -1)
-            kept.append(S if states == "all" else S[-1:])
+            last = S[-1]
+            kept.append(S[-1:] if final else S if every else S[:, picked])
             outputs.append(np.asarray(OUT).T.reshape(k, -1))
-        return np.vstack(kept) if states == "all" else kept[-1], np.vstack(outputs)
+        return kept[-1] if final else np.vstack(kept), np.vstack(outputs)
+
+    def _kept_entries(self, states) -> tuple[int, ...]:
+        """The state entries ``run`` keeps the history of: all for ``"all"``, none for ``"final"``, else the
+        positions of the names given (ObserverError for anything else, an unknown name listing the known)."""
+        if isinstance(states, str):
+            if states == "all":
+                return tuple(range(self.state.size))
+            if states == "final":
+                return ()
+            raise ObserverError(f"{self.name}: states must be 'all', 'final' or a sequence of state names, "
+                                f"got {states!r}")
+        try:
+            names = list(states)
+        except TypeError:
+            raise ObserverError(f"{self.name}: states must be 'all', 'final' or a sequence of state names, "
+                                f"got {states!r}") from None
+        if not names:
+            raise ObserverError(f"{self.name}: states as a selection must name at least one state entry, got "
+                                f"{states!r}")
+        if not all(isinstance(name, str) for name in names):
+            raise ObserverError(f"{self.name}: states as a selection holds state names (strings), got {states!r}")
+        try:
+            return tuple(self.state.indices(names))
+        except UnknownNameError as error:
+            raise ObserverError(f"{self.name}: states: {error}") from None
 
 
 RUN_CHUNK = 2048  # samples per mapaccum call of Observer.run
 COMPILE_FROM = 5000  # samples from which Observer.run compiles its steps by default
 
 
-@memoized(32)
-def _compiled_roll(step: ca.Function, required: bool, history: bool = True):
-    """``roll(s0, W, rows) -> s_end`` of ``step`` in C (W's rows [y; u; p], each row of ``rows`` [out; s_next],
-    or [out] without the state ``history``); None without a compiler unless ``required`` (then CodegenError)."""
+@memoized(32, key=lambda step, required, history: (step, required, None if history is None
+                                                   else np.asarray(history, dtype=np.int64)))
+def _compiled_roll(step: ca.Function, required: bool, history: tuple[int, ...] | None):
+    """``roll(s0, W, rows) -> s_end`` of ``step`` in C (W's rows [y; u; p], each row of ``rows`` [out; the
+    ``history`` entries of s_next]: every entry for None, just [out] for none); None without a compiler unless
+    ``required`` (then CodegenError). Memoized with the positions as one array (a key of 235 numbers frozen one
+    by one would cost 0.1 ms a call)."""
     from uvsym.codegen.compile import DEFAULT_FLAGS, compile_roll
     from uvsym.errors import CodegenError
 
     s, y, u, p = (ca.SX.sym(name, step.size1_in(i)) for i, name in enumerate(STEP_INPUTS))
     s_next, out = step(s, y, u, p)
-    rows = ca.vertcat(out, s_next) if history else out
-    rolled = ca.Function(f"{step.name()}_run{'' if history else '_out'}", [s, ca.vertcat(y, u, p)], [s_next, rows])
+    every = history is None or history == tuple(range(step.size1_in(0)))
+    rows = ca.vertcat(out, s_next) if every else ca.vertcat(out, s_next[list(history)]) if history else out
+    suffix = "" if every else "_out" if not history else "_" + hashlib.sha1(repr(history).encode()).hexdigest()[:12]
+    rolled = ca.Function(f"{step.name()}_run{suffix}", [s, ca.vertcat(y, u, p)], [s_next, rows])
     try:
         return compile_roll(rolled, DEFAULT_FLAGS)
     except CodegenError:
