@@ -76,13 +76,13 @@ int uvsym_box_reduce(int n, int m, int count, int combastel, void *work) {
     for (int i = 0; i < n; ++i) {
         const double *row = G + i * m;
         double *target = out + i * width;
-        for (int k = 0; k < kept; ++k) target[k] = row[order[k]];
+        for (int t = 0; t < kept; ++t) target[t] = row[order[t]];
         /* the row's sum over the replaced generators in eight interleaved partial sums (a vector
            of independent additions instead of one chain of m) */
         double part[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, tail = 0.0;
         int j = 0;
         for (; j + 8 <= m; j += 8)
-            for (int k = 0; k < 8; ++k) part[k] += in_box[j + k] * fabs(row[j + k]);
+            for (int q = 0; q < 8; ++q) part[q] += in_box[j + q] * fabs(row[j + q]);
         for (; j < m; ++j) tail += in_box[j] * fabs(row[j]);
         box[i] = (((part[0] + part[1]) + (part[2] + part[3])) + ((part[4] + part[5]) + (part[6] + part[7]))) + tail;
     }
