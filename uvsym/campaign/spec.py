@@ -24,7 +24,6 @@ scenario table: the key a resumed campaign skips finished runs by.
 
 from __future__ import annotations
 
-import copy
 import hashlib
 import itertools
 import json
@@ -35,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uvsym.campaign.dotted import flatten, new_entry, parse_path, set_path
+from uvsym.campaign.dotted import copied, flatten, new_entry, parse_path, set_path
 from uvsym.errors import CampaignError, CampaignSizeError, ScenarioError, UvsymError, did_you_mean
 from uvsym.sim.fields import Fields
 from uvsym.sim.shipped import every_shipped_scenario
@@ -307,7 +306,7 @@ def _draw(rng: np.random.Generator, kind: str, args):
         return float(rng.normal(args[0], args[1]))
     if kind == "integers":
         return int(rng.integers(args[0], args[1], endpoint=True))
-    return copy.deepcopy(args[int(rng.integers(len(args)))])
+    return copied(args[int(rng.integers(len(args)))])
 
 
 def _count(spec: dict) -> int:
@@ -340,7 +339,7 @@ def _expand(spec: dict) -> list[Run]:
     made = [entry for entry in (new_entry(spec["base"], path) for path in paths + drawn_paths) if entry]
     runs = []
     for point in itertools.product(*(values for _, values in spec["axes"])):
-        table = copy.deepcopy(spec["base"])
+        table = copied(spec["base"])
         fields: dict = {}
         for path, value in zip(paths, point):
             _apply(table, path, value, f"{where}: grid axis {path!r}")
@@ -353,7 +352,7 @@ def _expand(spec: dict) -> list[Run]:
         for draw in range(count):
             # one generator per (master seed, case, grid point, draw): draws do not move when others are added
             rng = np.random.default_rng([seed, *np.frombuffer(digest[:16], dtype=np.uint32).tolist(), draw])
-            drawn, drawn_fields = copy.deepcopy(table), dict(fields)
+            drawn, drawn_fields = copied(table), dict(fields)
             for path, kind, args in distributions:
                 value = _draw(rng, kind, args)
                 _apply(drawn, path, value, f"{where}: monte_carlo field {path!r}")
