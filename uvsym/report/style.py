@@ -90,8 +90,9 @@ def _outside(legend, ax) -> bool:
 
 def text_outside_figure(fig, tolerance_px: float = 0.5) -> list[str]:
     """The visible texts of ``fig`` (labels, titles, tick labels, legends, annotations) whose drawn
-    extent leaves the figure, as ``"text" at (x0, y0, x1, y1) px``; draws the figure to lay it out."""
-    fig.canvas.draw()
+    extent leaves the figure, as ``"text" at (x0, y0, x1, y1) px``; lays the figure out by a draw that renders
+    no pixels (the text's extents need the layout, not the raster: a fifth of a figure's save)."""
+    fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
     bounds, hidden = fig.bbox, _hidden_tick_labels(fig)
     clipped = []
