@@ -123,9 +123,9 @@ def _address(array: np.ndarray) -> int:
 
 @functools.lru_cache(maxsize=32)
 def _workspace(n: int, m: int, count: int, combastel: bool) -> tuple:
-    """One work buffer per shape (the C layout): numpy views of its G, out, replaced and box parts, and
-    the kernel's call on it with every argument bound. G is copied in (cheaper than reading an array's
-    address)."""
+    """One work buffer per shape (the C layout): numpy views of its G, out (one per number of columns written:
+    slicing anew costs as much as the copy), replaced and box parts, and the kernel's call on it with every
+    argument bound. G is copied in (cheaper than reading an array's address)."""
     width = m - count + n
     doubles = n * m + n * width + n + 2 * m
     work = np.zeros(doubles * 8 + m * 4 + m, dtype=np.uint8)
@@ -135,7 +135,8 @@ def _workspace(n: int, m: int, count: int, combastel: bool) -> tuple:
     box = as_doubles[n * m + n * width:n * m + n * width + n]
     replaced = work[doubles * 8 + m * 4:]
     call = functools.partial(_library(), int(n), int(m), int(count), int(combastel), ctypes.c_void_p(_address(work)))
-    return G, out, replaced, box, call  # the int()s: a numpy integer has no ctypes conversion without argtypes
+    written = tuple(out[:, :columns] for columns in range(width + 1))
+    return G, written, replaced, box, call  # the int()s: a numpy integer has no ctypes conversion without argtypes
 
 
 def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True):
@@ -145,9 +146,9 @@ def box_reduce(G: np.ndarray, count: int, combastel: bool, details: bool = True)
     function = _library()
     if function is None:
         return None
-    G_in, out, replaced, box, call = _workspace(*G.shape, count, combastel)
+    G_in, written, replaced, box, call = _workspace(*G.shape, count, combastel)
     G_in[...] = G
-    columns = call()
+    new_G = written[call()].copy()
     if not details:
-        return out[:, :columns].copy(), None, None
-    return out[:, :columns].copy(), replaced.astype(bool), box.copy()
+        return new_G, None, None
+    return new_G, replaced.astype(bool), box.copy()
