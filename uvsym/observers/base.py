@@ -26,7 +26,6 @@ scalar or compiled; it exports to C (:mod:`uvsym.codegen`); a report renders its
 
 from __future__ import annotations
 
-import hashlib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -156,8 +155,8 @@ class Observer:
             raise ObserverError(f"{self.name}: inputs U must be finite and measurements Y finite"
                                 + (" or NaN" if missing_y else ""))
         kept_entries = self._kept_entries(states)
-        final, every = (isinstance(states, str) and states == choice for choice in ("final", "all"))
-        picked = list(kept_entries)
+        every, final = kept_entries is None, kept_entries == ()
+        picked = list(range(self.state.size) if every else kept_entries)
         p = self.parameters(p)
         first = next((k for k in range(len(Y)) if np.all(np.isfinite(Y[k]))), 0)
         s = self.initial_state(np.nan_to_num(Y[first]), U[0], p) if s0 is None else \
@@ -166,14 +165,14 @@ class Observer:
             raise ObserverError(f"{self.name}: s0 must be {self.state.size} finite values, got {s.size}")
         roll = None
         if compiled or (compiled is None and len(Y) >= COMPILE_FROM and not missing_y):
-            roll = _compiled_roll(self.step, bool(compiled), None if every else kept_entries)
+            roll = _compiled_roll(self.step, bool(compiled), kept_entries)
         if roll is not None:
             W = np.ascontiguousarray(np.column_stack([Y, U, np.broadcast_to(p, (len(Y), p.size))]))
             n_out = self.publishes.size
             if final:
                 outputs = np.empty((len(Y), n_out))
                 return np.asarray(roll(s, W, outputs)).reshape(1, -1), outputs
-            rows = np.empty((len(Y) + 1, n_out + len(kept_entries)))  # rows [out; kept s]: S and OUT views, no copy
+            rows = np.empty((len(Y) + 1, n_out + len(picked)))  # rows [out; kept s]: S and OUT views, no copy
             rows[0, :n_out], rows[0, n_out:] = np.nan, s[picked]
             roll(s, W, rows[1:])
             return rows[:, n_out:], rows[1:, :n_out]
@@ -187,12 +186,13 @@ class Observer:
             outputs.append(np.asarray(OUT).T.reshape(k, -1))
         return kept[-1] if final else np.vstack(kept), np.vstack(outputs)
 
-    def _kept_entries(self, states) -> tuple[int, ...]:
-        """The state entries ``run`` keeps the history of: all for ``"all"``, none for ``"final"``, else the
-        positions of the names given (ObserverError for anything else, an unknown name listing the known)."""
+    def _kept_entries(self, states) -> tuple[int, ...] | None:
+        """The state entries ``run`` keeps the history of: None (every one) for ``"all"``, none for ``"final"``,
+        else the positions of the names given (ObserverError for anything else, an unknown name listing the
+        known)."""
         if isinstance(states, str):
             if states == "all":
-                return tuple(range(self.state.size))
+                return None
             if states == "final":
                 return ()
             raise ObserverError(f"{self.name}: states must be 'all', 'final' or a sequence of state names, "
@@ -231,7 +231,7 @@ def _compiled_roll(step: ca.Function, required: bool, history: tuple[int, ...] |
     s_next, out = step(s, y, u, p)
     every = history is None or history == tuple(range(step.size1_in(0)))
     rows = ca.vertcat(out, s_next) if every else ca.vertcat(out, s_next[list(history)]) if history else out
-    suffix = "" if every else "_out" if not history else "_" + hashlib.sha1(repr(history).encode()).hexdigest()[:12]
+    suffix = "" if every else "_kept" if history else "_out"  # the compile cache keys by the Function, not its name
     rolled = ca.Function(f"{step.name()}_run{suffix}", [s, ca.vertcat(y, u, p)], [s_next, rows])
     try:
         return compile_roll(rolled, DEFAULT_FLAGS)
