@@ -24,6 +24,21 @@ def test_a_label_past_the_figure_edge_is_found_and_finish_brings_it_back():
         plt.close(fig)
 
 
+def test_the_tick_labels_of_an_axes_set_off_are_not_taken_for_text_outside_the_figure():
+    with figure_style():
+        fig, ax = plt.subplots(figsize=(2.5, 1.8))
+        ax.text(0.5, 0.5, "no run finished", ha="center", va="center", transform=ax.transAxes)
+        fig.subplots_adjust(left=0.0, bottom=0.0)  # its tick labels would lie past the edge, were they drawn
+        assert text_outside_figure(fig)  # the tick labels, drawn
+        ax.set_axis_off()
+        assert text_outside_figure(fig) == []
+        ax.set_axis_on()
+        ax.yaxis.set_visible(False)
+        ax.xaxis.set_visible(False)
+        assert text_outside_figure(fig) == []
+        plt.close(fig)
+
+
 def test_the_colour_cycle_is_the_colour_blind_safe_palette():
     with figure_style():
         fig, ax = plt.subplots()

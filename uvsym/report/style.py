@@ -107,14 +107,16 @@ def text_outside_figure(fig, tolerance_px: float = 0.5) -> list[str]:
 
 
 def _hidden_tick_labels(fig) -> set[int]:
-    """ids of the tick labels matplotlib does not draw: their tick lies outside the axis' view."""
+    """ids of the tick labels matplotlib does not draw: their tick lies outside the axis' view, or their axis
+    (or its axes, ``set_axis_off``) is not drawn."""
     hidden = set()
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
+            drawn = ax.axison and axis.get_visible()
             low, high = sorted(axis.get_view_interval())
             slack = 1e-9 * max(abs(low), abs(high), 1.0)
             for tick in axis.get_major_ticks() + axis.get_minor_ticks():
-                if not low - slack <= tick.get_loc() <= high + slack:
+                if not drawn or not low - slack <= tick.get_loc() <= high + slack:
                     hidden.update((id(tick.label1), id(tick.label2)))
     return hidden
 
