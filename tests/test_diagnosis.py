@@ -246,3 +246,22 @@ def test_the_log_is_not_written_into_a_folder_that_does_not_exist(tmp_path):
     with pytest.raises(PathError, match="does not exist"):
         write_events([], tmp_path / "missing" / "events.json")
     assert not (tmp_path / "missing").exists()
+
+
+def test_the_fits_pseudo_inverse_is_numpys_bit_for_bit():
+    """fits._pinv replaces np.linalg.pinv(gram, rcond=1e-12, hermitian=True) on the diagnosis's Gram matrices: the
+    same bits, full rank or not (repeated and zero columns), of sizes 1 to 40, and a zero matrix."""
+    from uvsym.diagnosis.fits import _pinv
+
+    rng = np.random.default_rng(7)
+    for size in (1, 2, 3, 7, 19, 40):
+        for trial in range(40):
+            Z = rng.standard_normal((size + 30, size)) * rng.uniform(1e-3, 1e3, size)
+            if trial % 3 == 1 and size > 1:
+                Z[:, -1] = Z[:, 0]  # rank deficient: an eigenvalue at rounding level, cut off
+            if trial % 5 == 2:
+                Z[:, 0] = 0.0
+            gram = Z.T @ Z
+            assert _pinv(gram).tobytes() == np.linalg.pinv(gram, rcond=1e-12, hermitian=True).tobytes()
+    zero = np.zeros((4, 4))
+    assert _pinv(zero).tobytes() == np.linalg.pinv(zero, rcond=1e-12, hermitian=True).tobytes()
