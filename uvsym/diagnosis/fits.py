@@ -82,22 +82,19 @@ class _Columns:
         onset = h.onset if first < h.onset else 0
         return (h.actuator, onset) if h.at is None else (h.actuator, onset, h.kind.name, h.at)
 
-    def unit(self, column: int) -> np.ndarray:
-        w = np.zeros(self.size)
-        w[column] = 1.0
-        return w
-
-    def hypothesis(self, h: Hypothesis) -> tuple[np.ndarray, np.ndarray]:
-        """Coefficients (c, phi) over Z with ``r = c + f phi`` under h (module docstring of regressors)."""
-        j = self.index[self._key(h, self.rows0)]
-        c, phi = np.zeros(self.size), np.zeros(self.size)
-        if h.at is not None:  # the exact columns are c and phi themselves
-            c[j], phi[j + 1] = 1.0, 1.0
-            return c, phi
-        (g0, g1), (s0, s1) = h.kind.gain, h.kind.shift
-        c[j], c[j + 1] = s0, g0 - 1.0
-        phi[j], phi[j + 1] = s1, g1
-        return c, phi
+    def combinations(self, hypotheses: list[Hypothesis]) -> tuple[np.ndarray, np.ndarray]:
+        """Coefficients (C, Phi), each (size, len(hypotheses)), over Z: ``r = C[:, i] + f Phi[:, i]`` under
+        hypothesis i (module docstring of regressors)."""
+        C, Phi = np.zeros((self.size, len(hypotheses))), np.zeros((self.size, len(hypotheses)))
+        for i, h in enumerate(hypotheses):
+            j = self.index[self._key(h, self.rows0)]
+            if h.at is not None:  # the exact columns are c and phi themselves
+                C[j, i], Phi[j + 1, i] = 1.0, 1.0
+                continue
+            (g0, g1), (s0, s1) = h.kind.gain, h.kind.shift
+            C[j, i], C[j + 1, i] = s0, g0 - 1.0
+            Phi[j, i], Phi[j + 1, i] = s1, g1
+        return C, Phi
 
 
 def _schur(S: np.ndarray, basis: np.ndarray, W: np.ndarray, inverse: np.ndarray | None = None) -> np.ndarray:
@@ -133,25 +130,27 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     values: (len(model),) the model faults' decided sizes (for ``power``).
     """
     Z = _Columns(bank, rows, model + candidates)
-    free = np.eye(Z.size)[:, :Z.n_t]
-    model_cols = [Z.hypothesis(h) for h in model]
-    y = Z.unit(Z.n_t) - sum((c for c, _ in model_cols), np.zeros(Z.size))
-    basis = np.column_stack([free] + [phi[:, None] for _, phi in model_cols])
+    C_model, Phi_model = Z.combinations(model)
+    y, faults = np.zeros(Z.size), np.zeros(Z.size)
+    y[Z.n_t] = 1.0
+    for i in range(len(model)):
+        faults = faults + C_model[:, i]
+    y = y - faults  # the residual's column less the model's faults
+    basis = np.hstack([np.eye(Z.size)[:, :Z.n_t], Phi_model])  # the free response and the model's faults
     SB = Z.S @ basis
     inverse = _pinv(basis.T @ SB)
     theta_model, cov_model = (inverse @ (SB.T @ y))[Z.n_t:], inverse[Z.n_t:, Z.n_t:]
     J_model = float(_schur(Z.S, basis, y[:, None], inverse)[0, 0])
     removal, power = np.zeros(len(model)), np.zeros(len(model))
-    for i, (c, phi) in enumerate(model_cols):
+    for i in range(len(model)):
+        c, phi = C_model[:, i], Phi_model[:, i]
         others = np.delete(basis, Z.n_t + i, axis=1)
         gram = _schur(Z.S, others, np.column_stack([y + c, c + values[i] * phi]))
         removal[i], power[i] = gram[0, 0] - J_model, gram[1, 1]
     if not candidates:
         return WindowFit(J_model, theta_model, cov_model, removal, power, np.zeros(0), np.zeros(0), np.zeros(0))
-    cols = [Z.hypothesis(h) for h in candidates]
-    U = np.column_stack([y - c for c, _ in cols])  # each candidate's target
-    X = np.column_stack([phi for _, phi in cols])
-    gram = _schur(Z.S, basis, np.hstack([U, X]), inverse)
+    C, X = Z.combinations(candidates)
+    gram = _schur(Z.S, basis, np.hstack([y[:, None] - C, X]), inverse)  # each candidate's target, its column
     H = len(candidates)
     uu, ux, xx = np.diagonal(gram[:H, :H]), np.diagonal(gram[:H, H:]), np.diagonal(gram[H:, H:])
     seen = xx > 1e-12 * max(float(np.max(xx)), 1e-300)
