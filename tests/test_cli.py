@@ -12,7 +12,7 @@ from uvsym.cli import main
 
 
 def test_version_through_the_module_entry_point():
-    """One of the two tests that start ``python -m uvsym.cli`` in its own process (the others call ``main`` directly)."""
+    """One of the two tests that start ``python -m uvsym.cli`` in its own process (the others call ``main``)."""
     result = subprocess.run([sys.executable, "-m", "uvsym.cli", "--version"], capture_output=True, text=True,
                             timeout=300)
     assert result.returncode == 0 and result.stdout.strip() == f"uvsym {uvsym.__version__}"

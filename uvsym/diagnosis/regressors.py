@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 
 from uvsym.errors import ObserverError
+from uvsym.evaluation import InPlace
 from uvsym.models.model import Model
 
 __all__ = ["RegressorBank", "ResidualNoise"]
@@ -100,8 +101,8 @@ class RegressorBank:
             return
         u_in = np.clip(u_e, *self._inside)
         n, m = self.n, self.m
-        B = np.asarray(self._mapped(self.model.B.raw, k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0))  # (n, k m)
-        slope = np.asarray(self._mapped(self._slope, k)(y[:, :n].T, y[:, n:].T, u_e.T))
+        B = self._mapped(self.model.B.raw, k)(y[:, :n].T, y[:, n:].T, u_in.T, 0.0, 0.0)[0]  # (n, k m)
+        slope = self._mapped(self._slope, k)(y[:, :n].T, y[:, n:].T, u_e.T)[0]
         slope = slope.reshape(n, k, n).transpose(1, 0, 2)
         E = self._E @ slope  # (k, n, n)
         slow = (E**2 @ self.noise.velocity_std**2) / np.maximum(1.0 - np.abs(np.diag(self.Phi)), 1e-12) ** 2
@@ -156,7 +157,7 @@ class RegressorBank:
         u[1, :, actuator] = kind.deliver(u_e[:, actuator], theta - step)
         u[2, :, actuator] = kind.deliver(u_e[:, actuator], theta + step)
         eta, nu = np.tile(y[:, :n].T, 3), np.tile(y[:, n:].T, 3)
-        tau = np.asarray(self._mapped(self.model.tau.raw, 3 * length)(eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0))
+        tau = self._mapped(self.model.tau.raw, 3 * length)(eta, nu, u.reshape(-1, self.m).T, 0.0, 0.0)[0]
         tau = tau.T.reshape(3, length, n)
         low, high = tau[1] - tau[0], tau[2] - tau[0]
         return (low + high) / 2, (high - low) / (2 * step)
@@ -178,11 +179,12 @@ class RegressorBank:
                                                zi=state[..., j])
         return out @ self.V.T, state
 
-    def _mapped(self, function, k: int):
-        """``function`` mapped over k samples, built once per (function, k)."""
+    def _mapped(self, function, k: int) -> InPlace:
+        """``function`` mapped over k samples, evaluated in place (:class:`~uvsym.evaluation.InPlace`), built once
+        per (function, k)."""
         key = (function.name(), k)
         if key not in self._maps:
-            self._maps[key] = function.map(k)
+            self._maps[key] = InPlace(function.map(k))
         return self._maps[key]
 
     def transient(self, rows: np.ndarray) -> np.ndarray:

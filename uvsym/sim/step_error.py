@@ -29,6 +29,7 @@ import numpy as np
 from uvsym.codegen.cache import memoized
 from uvsym.codegen.compile import DEFAULT_FLAGS, compile_function
 from uvsym.errors import CodegenError, IntegrationAccuracyWarning, SimulationError
+from uvsym.evaluation import InPlace
 from uvsym.faults import actuator_fault_affine
 from uvsym.sim.inputs import input_column, input_rows
 from uvsym.symbolic import rk4, rk4_stage_times
@@ -133,10 +134,11 @@ def _doubled_by_faults(fault_ode: ca.Function, dt: float, substeps: int) -> ca.F
 
 
 @memoized(16)
-def _mapped(doubled: ca.Function, runs: int, compiled: bool) -> ca.Function:
-    """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column; compiled: its C
-    (from the compile cache; CasADi's virtual machine where there is no compiler)."""
-    return (_compiled(doubled) if compiled else doubled).map(CHECKS * runs)
+def _mapped(doubled: ca.Function, runs: int, compiled: bool) -> InPlace:
+    """``doubled`` over the ``CHECKS`` steps of each of ``runs`` runs at once, one per column, evaluated in place
+    (:class:`~uvsym.evaluation.InPlace`); compiled: its C (from the compile cache; CasADi's virtual machine where
+    there is no compiler)."""
+    return InPlace((_compiled(doubled) if compiled else doubled).map(CHECKS * runs))
 
 
 @memoized(16)
@@ -207,7 +209,7 @@ def _redone(loop, plans, faults, compiled: bool) -> tuple[np.ndarray, np.ndarray
     arguments = [np.concatenate(parts, axis=1) for parts in zip(*arguments)]
     doubled = _doubled_by_faults(loop.fault_ode, loop.dt, loop.substeps) if loop.fault_ode is not None \
         else _doubled(loop.plant_ode, loop.dt, loop.substeps)
-    coarse, fine = (np.asarray(v).T for v in _mapped(doubled, len(plans), compiled)(*arguments))
+    coarse, fine = (v.T for v in _mapped(doubled, len(plans), compiled)(*arguments))
     return coarse, fine
 
 
