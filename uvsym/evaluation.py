@@ -33,22 +33,23 @@ class InPlace:
     """
 
     def __init__(self, function: ca.Function):
+        self.name = function.name()
         for i in range(function.n_in()):
             if not function.sparsity_in(i).is_dense():
                 raise ValueError(f"{function.name()}: input {function.name_in(i)} is sparse; InPlace takes dense "
                                  "inputs")
+        if not all(function.sparsity_out(i).is_dense() for i in range(function.n_out())):
+            # its outputs' structural zeros written out: an MX call of the Function (evaluated as it is), densified
+            inputs = function.mx_in()
+            function = ca.Function(f"{self.name}_dense", inputs, [ca.densify(v) for v in function.call(inputs)],
+                                   function.name_in(), function.name_out())
         self.function = function
         self._inputs = [function.size_in(i) for i in range(function.n_in())]
-        self._outputs = []  # (rows, cols), and for a sparse output the (row, col) of each stored entry
-        for i in range(function.n_out()):
-            sparsity = function.sparsity_out(i)
-            stored = None if sparsity.is_dense() else (np.asarray(sparsity.row(), dtype=np.int_),
-                                                      np.asarray(sparsity.get_col(), dtype=np.int_))
-            self._outputs.append((function.size_out(i), stored))
+        self._outputs = [function.size_out(i) for i in range(function.n_out())]
 
     def __call__(self, *arguments) -> list[np.ndarray]:
         if len(arguments) != len(self._inputs):
-            raise ValueError(f"{self.function.name()} takes {len(self._inputs)} arguments, got {len(arguments)}")
+            raise ValueError(f"{self.name} takes {len(self._inputs)} arguments, got {len(arguments)}")
         buffer, trigger = self.function.buffer()  # one per call (a few us): threads may share an InPlace
         held = []  # the arguments' column-major copies, alive until the evaluation is done
         for i, (argument, (rows, cols)) in enumerate(zip(arguments, self._inputs)):
@@ -58,22 +59,14 @@ class InPlace:
             elif value.ndim == 1 and cols == 1 and value.size == rows:
                 value = value[:, None]
             if value.shape != (rows, cols):
-                raise ValueError(f"{self.function.name()}: argument {self.function.name_in(i)} must be ({rows}, "
+                raise ValueError(f"{self.name}: argument {self.function.name_in(i)} must be ({rows}, "
                                  f"{cols}), got {value.shape}")
             held.append(np.ascontiguousarray(value.T))  # CasADi is column-major: the C-ordered transpose
             buffer.set_arg(i, memoryview(held[-1].reshape(-1)))
-        stored = [np.empty(self.function.nnz_out(i)) for i in range(len(self._outputs))]
-        for i, values in enumerate(stored):
-            buffer.set_res(i, memoryview(values))
+        outputs = [np.empty((cols, rows)) for rows, cols in self._outputs]  # column-major (rows, cols)
+        for i, values in enumerate(outputs):
+            buffer.set_res(i, memoryview(values.reshape(-1)))
         trigger()
         if buffer.ret():
-            raise RuntimeError(f"{self.function.name()}: the evaluation failed (error {buffer.ret()})")
-        outputs = []
-        for values, ((rows, cols), entries) in zip(stored, self._outputs):
-            if entries is None:
-                outputs.append(np.ascontiguousarray(values.reshape(cols, rows).T))
-            else:
-                dense = np.zeros((rows, cols))
-                dense[entries] = values
-                outputs.append(dense)
-        return outputs
+            raise RuntimeError(f"{self.name}: the evaluation failed (error {buffer.ret()})")
+        return [np.ascontiguousarray(values.T) for values in outputs]
