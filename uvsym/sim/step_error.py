@@ -229,14 +229,16 @@ def _stage_faults(loop, faults, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _plan(loop, outputs: np.ndarray, W, tolerance: float, faults, state_max=None):
     """(scale, outputs, W, checked samples) of a run's step check, or None where nothing can be checked. The
     logged rows are read back ``_ROWS`` at a time (each piece's temporaries stay small): the held inputs, and
-    each state entry's largest absolute value unless ``state_max`` (n_s,) gives it. The steps where an actuator fault
+    each state entry's largest absolute value unless ``state_max`` (n_s,) gives it (then in one piece: its
+    temporaries are the inputs' size, (N + 1, m)). The steps where an actuator fault
     switches: from ``faults`` (its profiles' jumps) where given, else where the logged ``fault_actuator`` turns
     zero or non-zero."""
     if len(W) < 2 or loop.integrated(outputs[:1]) is None:
         return None
     largest, inputs, faulty = [], [], []
-    for start in range(0, len(outputs), _ROWS):
-        rows = outputs[start:start + _ROWS]
+    piece = _ROWS if state_max is None else len(outputs)
+    for start in range(0, len(outputs), piece):
+        rows = outputs[start:start + piece]
         if state_max is None:
             S, U = loop.integrated(rows)
             largest.append(_column_max(S))
