@@ -265,3 +265,16 @@ def test_the_fits_pseudo_inverse_is_numpys_bit_for_bit():
             assert _pinv(gram).tobytes() == np.linalg.pinv(gram, rcond=1e-12, hermitian=True).tobytes()
     zero = np.zeros((4, 4))
     assert _pinv(zero).tobytes() == np.linalg.pinv(zero, rcond=1e-12, hermitian=True).tobytes()
+
+
+def test_the_ends_of_runs_of_consecutive_flags_are_what_a_box_convolution_counts():
+    from uvsym.diagnosis.detectors import ends_of_runs
+
+    rng = np.random.default_rng(11)
+    for size in (1, 2, 7, 300):
+        for density in (0.2, 0.7, 0.97):
+            flags = rng.random(size) < density
+            for length in {1, 2, 3, size, size + 2}:
+                box = np.convolve(flags.astype(int), np.ones(length, int))[:size] >= length
+                assert np.array_equal(ends_of_runs(flags, length), box), (size, density, length)
+    assert ends_of_runs(np.array([1, 1, 0, 1, 1, 1]), 2).tolist() == [False, True, False, False, True, True]

@@ -50,8 +50,7 @@ from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError
 
 __all__ = ["ResidualThreshold", "DoubleCriterion", "StepDecision", "EstimatedFault", "check_samples", "flag_events",
-           "threshold_factor",
-           "read_signal"]
+           "threshold_factor", "read_signal", "ends_of_runs"]
 
 
 def read_signal(result, name: str) -> np.ndarray:
@@ -61,6 +60,15 @@ def read_signal(result, name: str) -> np.ndarray:
         known = [f"{g}.{lab}" for g, s in result.signals.items() for lab in s.labels]
         raise DiagnosisError(f"signal {name!r} is not in the result; logged: {', '.join(known)}")
     return np.asarray(result[group][label], dtype=float)
+
+
+def ends_of_runs(flags: np.ndarray, length: int) -> np.ndarray:
+    """(N,) True at each sample that ends ``length`` (>= 1) consecutive true ``flags`` (N,): a running count in
+    integers, exactly what ``np.convolve(flags, np.ones(length))[:N] >= length`` gives in O(N length)."""
+    counts = np.cumsum(np.asarray(flags, dtype=np.int64))
+    window = counts.copy()
+    window[length:] -= counts[:-length]
+    return window >= length
 
 
 def check_samples(detector, *fields: str) -> None:
@@ -146,8 +154,8 @@ class ResidualThreshold:
         ratio[t < self.ignore_before - 1e-9 * max(1.0, abs(self.ignore_before))] = 0.0
         outside = (ratio.max(axis=1) > 1.0).astype(int)
         # samples ending a run of `confirm` samples outside, and of `release` samples inside
-        confirmed = np.flatnonzero(np.convolve(outside, np.ones(self.confirm, int))[:t.size] >= self.confirm)
-        released = np.flatnonzero(np.convolve(1 - outside, np.ones(self.release, int))[:t.size] >= self.release)
+        confirmed = np.flatnonzero(ends_of_runs(outside, self.confirm))
+        released = np.flatnonzero(ends_of_runs(1 - outside, self.release))
         events, k = [], -1
         while (i := np.searchsorted(confirmed, k, side="right")) < confirmed.size:
             k = int(confirmed[i])  # the first confirmation after the last clearance: an alarm

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from uvsym.codegen.cache import memoized
-from uvsym.diagnosis.detectors import read_signal
+from uvsym.diagnosis.detectors import ends_of_runs, read_signal
 from uvsym.diagnosis.events import Event
 from uvsym.errors import DiagnosisError, ScenarioError, SetError
 from uvsym.observers.uio_bank import isolate, outside_band, residual_bands
@@ -73,7 +73,7 @@ class ZonotopeBands:
         t = np.asarray(result.t, dtype=float)
         outside = self.outside(result)
         alarm = outside.any(axis=1)
-        quiet = np.convolve((~alarm).astype(int), np.ones(self.release, int))[:t.size] >= self.release
+        quiet = ends_of_runs(~alarm, self.release)
         events, k = [], 0
         while (hits := np.flatnonzero(alarm[k:])).size:
             k += int(hits[0])
