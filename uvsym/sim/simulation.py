@@ -183,8 +183,7 @@ def _run_inputs(loop: ClosedLoop, N: int, dt: float, env: np.ndarray, faults: tu
     m = loop.model.n_inputs
     constant = np.zeros(loop.n_w)
     constant[loop.correction_columns] = np.concatenate([np.eye(m).reshape(-1), np.zeros(m)])
-    blocks = [sample_inputs(1 + n_noise, N, dt, n_noise, seed)]  # t, noise: columns 0..n_noise
-    columns = [np.arange(1 + n_noise)]
+    columns, blocks = [np.arange(1 + n_noise)], []  # t, noise: columns 0..n_noise
     env_columns = np.arange(loop.n_w)[loop.env_columns]
     if env.shape == (2,):
         constant[env_columns] = env
@@ -194,7 +193,13 @@ def _run_inputs(loop: ClosedLoop, N: int, dt: float, env: np.ndarray, faults: tu
     touched, values = actuator_fault_table(loop, faults, N)
     blocks.append(values)
     columns.append(loop.fault_columns.start + touched)
-    return CompactInputs(constant, np.concatenate(columns).astype(np.int_), np.ascontiguousarray(np.hstack(blocks)))
+    columns = np.concatenate(columns).astype(np.int_)
+    rows = sample_inputs(columns.size, N, dt, n_noise, seed)  # the other blocks filled in place after t and noise
+    first = 1 + n_noise
+    for block in blocks:
+        rows[:, first:first + block.shape[1]] = block
+        first += block.shape[1]
+    return CompactInputs(constant, columns, rows)
 
 
 def _attitude_guard(loop):

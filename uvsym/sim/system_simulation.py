@@ -118,13 +118,15 @@ def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0, compact: bool = 
     per_sample(d, plant.d.size, N, "d")
     constant = np.zeros(loop.n_w)
     constant[loop.fault_columns] = [value for fault in loop.faults for value in fault_parameters(fault)]
-    blocks, columns = [sample_inputs(1 + n_noise, N, loop.dt, n_noise, seed)], [np.arange(1 + n_noise)]
+    columns = np.arange(1 + n_noise)
     if d.ndim == 1:
         constant[start:start + plant.d.size] = d
-    else:
-        blocks.append(d)
-        columns.append(np.arange(start, start + plant.d.size))
-    inputs = CompactInputs(constant, np.concatenate(columns).astype(np.int_), np.ascontiguousarray(np.hstack(blocks)))
+        rows = sample_inputs(1 + n_noise, N, loop.dt, n_noise, seed)
+    else:  # d's columns filled in place after the times and the draws
+        columns = np.concatenate([columns, np.arange(start, start + plant.d.size)])
+        rows = sample_inputs(columns.size, N, loop.dt, n_noise, seed)
+        rows[:, 1 + n_noise:] = d
+    inputs = CompactInputs(constant, columns.astype(np.int_), rows)
     return inputs if compact else inputs.dense()
 
 
