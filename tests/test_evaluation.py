@@ -6,6 +6,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from uvsym.errors import ArgumentError
 from uvsym.evaluation import InPlace
 from uvsym.models.registry import vehicle
 
@@ -41,12 +42,12 @@ def test_numbers_fill_their_input_and_a_column_takes_a_one_dimensional_array():
 def test_bad_arguments_and_sparse_inputs_are_refused_by_name():
     x = ca.SX.sym("x", 3)
     f = InPlace(ca.Function("f", [x], [2 * x], ["state"], ["out"]))
-    with pytest.raises(ValueError, match="takes 1 arguments, got 2"):
+    with pytest.raises(ArgumentError, match="takes 1 arguments, got 2"):
         f(np.zeros(3), 1.0)
-    with pytest.raises(ValueError, match=r"argument state must be \(3, 1\), got \(4,\)"):
+    with pytest.raises(ArgumentError, match=r"argument state must be \(3, 1\), got \(4,\)"):
         f(np.zeros(4))
     sparse = ca.SX.sym("s", ca.Sparsity.diag(3))
-    with pytest.raises(ValueError, match="input s is sparse"):
+    with pytest.raises(ArgumentError, match="input s is sparse"):
         InPlace(ca.Function("g", [sparse], [ca.sum1(sparse)], ["s"], ["o"]))
 
 

@@ -104,7 +104,8 @@ class CovarianceError(ObserverError):
 class ArgumentError(UvsymError, ValueError):
     """A Model's, System's or Observer's Function was called with an argument of the wrong size,
     an unknown name or non-finite values, or gives non-finite outputs there (names the argument
-    and the entry)."""
+    and the entry); or a Function evaluated in place (:class:`~uvsym.evaluation.InPlace`) was given
+    the wrong arguments or failed (names the Function)."""
 
 
 class PathError(UvsymError, OSError):

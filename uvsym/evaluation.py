@@ -11,6 +11,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from uvsym.errors import ArgumentError
+
 __all__ = ["InPlace"]
 
 
@@ -25,18 +27,16 @@ class InPlace:
 
     Raises
     ------
-    ValueError
-        For a Function with a sparse input (built here), a wrong number of arguments, or an argument
-        of another shape.
-    RuntimeError
-        When the evaluation fails (the Function's own error code).
+    ArgumentError
+        For a Function with a sparse input (built here), a wrong number of arguments, an argument of
+        another shape, or an evaluation that fails (the Function's own error code).
     """
 
     def __init__(self, function: ca.Function):
         self.name = function.name()
         for i in range(function.n_in()):
             if not function.sparsity_in(i).is_dense():
-                raise ValueError(f"{function.name()}: input {function.name_in(i)} is sparse; InPlace takes dense "
+                raise ArgumentError(f"{function.name()}: input {function.name_in(i)} is sparse; InPlace takes dense "
                                  "inputs")
         if not all(function.sparsity_out(i).is_dense() for i in range(function.n_out())):
             # its outputs' structural zeros written out: an MX call of the Function (evaluated as it is), densified
@@ -49,7 +49,7 @@ class InPlace:
 
     def __call__(self, *arguments) -> list[np.ndarray]:
         if len(arguments) != len(self._inputs):
-            raise ValueError(f"{self.name} takes {len(self._inputs)} arguments, got {len(arguments)}")
+            raise ArgumentError(f"{self.name} takes {len(self._inputs)} arguments, got {len(arguments)}")
         buffer, trigger = self.function.buffer()  # one per call (a few us): threads may share an InPlace
         held = []  # the arguments' column-major copies, alive until the evaluation is done
         for i, (argument, (rows, cols)) in enumerate(zip(arguments, self._inputs)):
@@ -59,7 +59,7 @@ class InPlace:
             elif value.ndim == 1 and cols == 1 and value.size == rows:
                 value = value[:, None]
             if value.shape != (rows, cols):
-                raise ValueError(f"{self.name}: argument {self.function.name_in(i)} must be ({rows}, "
+                raise ArgumentError(f"{self.name}: argument {self.function.name_in(i)} must be ({rows}, "
                                  f"{cols}), got {value.shape}")
             held.append(np.ascontiguousarray(value.T))  # CasADi is column-major: the C-ordered transpose
             buffer.set_arg(i, memoryview(held[-1].reshape(-1)))
@@ -68,5 +68,5 @@ class InPlace:
             buffer.set_res(i, memoryview(values.reshape(-1)))
         trigger()
         if buffer.ret():
-            raise RuntimeError(f"{self.name}: the evaluation failed (error {buffer.ret()})")
+            raise ArgumentError(f"{self.name}: the evaluation failed (error {buffer.ret()})")
         return [np.ascontiguousarray(values.T) for values in outputs]

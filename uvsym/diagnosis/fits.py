@@ -131,11 +131,11 @@ def fit_window(bank: RegressorBank, rows: np.ndarray, model: list[Hypothesis], v
     """
     Z = _Columns(bank, rows, model + candidates)
     C_model, Phi_model = Z.combinations(model)
-    y, faults = np.zeros(Z.size), np.zeros(Z.size)
+    y, decided = np.zeros(Z.size), np.zeros(Z.size)
     y[Z.n_t] = 1.0
     for i in range(len(model)):
-        faults = faults + C_model[:, i]
-    y = y - faults  # the residual's column less the model's faults
+        decided = decided + C_model[:, i]
+    y = y - decided  # the residual's column less the decided faults' own terms
     basis = np.hstack([np.eye(Z.size)[:, :Z.n_t], Phi_model])  # the free response and the model's faults
     SB = Z.S @ basis
     inverse = _pinv(basis.T @ SB)
