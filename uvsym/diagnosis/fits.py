@@ -110,13 +110,16 @@ def _pinv(gram: np.ndarray) -> np.ndarray:
     """The pseudo-inverse of a symmetric Gram matrix (singular values below 1e-12 of the largest dropped).
 
     ``np.linalg.pinv(gram, rcond=1e-12, hermitian=True)`` bit for bit -- its eigendecomposition, order, cut-off
-    and products, on arrays of the same layouts -- without its checks and wrapping (a third of its time on the
-    diagnosis's small matrices)."""
+    and products, on arrays of the same layouts (BLAS may round a product of other layouts otherwise) --
+    without its checks and wrapping (a third of its time on the diagnosis's small matrices)."""
+    if gram.size == 0:
+        return np.empty(gram.shape[::-1])
     s, u = np.linalg.eigh(gram)
     sign = np.copysign(1.0, s)
     s = np.abs(s)
     order = np.argsort(s)[::-1]  # the singular values, descending
-    sign, s, u = sign[order], s[order], u[:, order]
+    sign, s = sign[order], s[order]
+    u = np.take_along_axis(u, order[None, :], axis=-1)  # C-ordered, as numpy's (u[:, order] is not)
     large = s > 1e-12 * s.max()
     s = np.divide(1, s, where=large, out=s)
     s[~large] = 0
