@@ -18,7 +18,7 @@ def test_version_through_the_module_entry_point():
     assert result.returncode == 0 and result.stdout.strip() == f"uvsym {uvsym.__version__}"
 
 
-def test_the_console_entry_point_exits_with_the_status_main_returns():
+def test_the_module_entry_point_exits_with_the_status_main_returns():
     result = subprocess.run([sys.executable, "-m", "uvsym.cli", "models", "show", "nosuch"], capture_output=True,
                             text=True, timeout=300)
     assert result.returncode == 2 and result.stderr.startswith("uvsym: error:") and "nosuch" in result.stderr

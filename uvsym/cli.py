@@ -7,7 +7,6 @@ runs, and only once its names are checked: ``--help`` and a misspelt name answer
 from __future__ import annotations
 
 import argparse
-import gc
 import json
 import os
 import sys
@@ -606,14 +605,5 @@ def main(argv: list[str] | None = None) -> int:
         return 0
 
 
-def console() -> None:
-    """The ``uvsym`` console script: :func:`main`, then exit with its status. Every object alive by then is
-    frozen out of the garbage collector first (:func:`gc.freeze`): the interpreter's teardown then does not
-    trace the CasADi, numpy and matplotlib objects the command loaded (about 0.1 s of a campaign's exit)."""
-    status = main()
-    gc.freeze()
-    sys.exit(status)
-
-
 if __name__ == "__main__":
-    console()
+    sys.exit(main())
