@@ -46,6 +46,11 @@ def test_bad_arguments_and_sparse_inputs_are_refused_by_name():
         f(np.zeros(3), 1.0)
     with pytest.raises(ArgumentError, match=r"argument state must be \(3, 1\), got \(4,\)"):
         f(np.zeros(4))
+    with pytest.raises(ArgumentError, match="argument state must be real numbers, got complex128"):
+        f(np.array([1 + 5j, 2, 3]))
+    with pytest.raises(ArgumentError, match="must be real numbers"):
+        f(["a", "b", "c"])
+    assert f(np.array([1, 2, 3]))[0].tolist() == [[2.0], [4.0], [6.0]]  # integers are real numbers
     sparse = ca.SX.sym("s", ca.Sparsity.diag(3))
     with pytest.raises(ArgumentError, match="input s is sparse"):
         InPlace(ca.Function("g", [sparse], [ca.sum1(sparse)], ["s"], ["o"]))

@@ -28,13 +28,20 @@ def test_the_tick_labels_of_an_axes_set_off_are_not_taken_for_text_outside_the_f
     with figure_style():
         fig, ax = plt.subplots(figsize=(2.5, 1.8))
         ax.text(0.5, 0.5, "no run finished", ha="center", va="center", transform=ax.transAxes)
-        fig.subplots_adjust(left=0.0, bottom=0.0)  # its tick labels would lie past the edge, were they drawn
-        assert text_outside_figure(fig)  # the tick labels, drawn
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("value")
+        fig.subplots_adjust(left=0.0, bottom=0.0)  # its tick and axis labels would lie past the edge, if drawn
+        drawn = text_outside_figure(fig)
+        assert any("time (s)" in d for d in drawn) and any("'0.0'" in d for d in drawn)
         ax.set_axis_off()
         assert text_outside_figure(fig) == []
         ax.set_axis_on()
         ax.yaxis.set_visible(False)
         ax.xaxis.set_visible(False)
+        assert text_outside_figure(fig) == []
+        ax.xaxis.set_visible(True)
+        assert any("time (s)" in d for d in text_outside_figure(fig))
+        ax.set_visible(False)
         assert text_outside_figure(fig) == []
         plt.close(fig)
 

@@ -29,7 +29,8 @@ class InPlace:
     ------
     ArgumentError
         For a Function with a sparse input (built here), a wrong number of arguments, an argument of
-        another shape, or an evaluation that fails (the Function's own error code).
+        another shape or not of real numbers (complex, text), or an evaluation that fails (the Function's
+        own error code).
     """
 
     def __init__(self, function: ca.Function):
@@ -53,7 +54,11 @@ class InPlace:
         buffer, trigger = self.function.buffer()  # one per call (a few us): threads may share an InPlace
         held = []  # the arguments' column-major copies, alive until the evaluation is done
         for i, (argument, (rows, cols)) in enumerate(zip(arguments, self._inputs)):
-            value = np.asarray(argument, dtype=float)
+            value = np.asarray(argument)
+            if value.dtype.kind not in "biuf":
+                raise ArgumentError(f"{self.name}: argument {self.function.name_in(i)} must be real numbers, got "
+                                    f"{value.dtype}")
+            value = value.astype(float, copy=False)
             if value.size == 1 and value.shape != (rows, cols):
                 value = np.full((rows, cols), value.item())
             elif value.ndim == 1 and cols == 1 and value.size == rows:

@@ -94,7 +94,7 @@ def text_outside_figure(fig, tolerance_px: float = 0.5) -> list[str]:
     no pixels (the text's extents need the layout, not the raster: a fifth of a figure's save)."""
     fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
-    bounds, hidden = fig.bbox, _hidden_tick_labels(fig)
+    bounds, hidden = fig.bbox, _undrawn_texts(fig)
     clipped = []
     for text in fig.findobj(matplotlib.text.Text):
         if not text.get_visible() or not text.get_text().strip() or id(text) in hidden:
@@ -106,13 +106,19 @@ def text_outside_figure(fig, tolerance_px: float = 0.5) -> list[str]:
     return clipped
 
 
-def _hidden_tick_labels(fig) -> set[int]:
-    """ids of the tick labels matplotlib does not draw: their tick lies outside the axis' view, or their axis
-    (or its axes, ``set_axis_off``) is not drawn."""
+def _undrawn_texts(fig) -> set[int]:
+    """ids of the texts matplotlib does not draw: every text of an invisible axes; the tick labels, label and
+    offset text of an axis not drawn (hidden, or its axes ``set_axis_off``); a tick label whose tick lies
+    outside the axis' view."""
     hidden = set()
     for ax in fig.axes:
+        if not ax.get_visible():
+            hidden.update(id(text) for text in ax.findobj(matplotlib.text.Text))
+            continue
         for axis in (ax.xaxis, ax.yaxis):
             drawn = ax.axison and axis.get_visible()
+            if not drawn:
+                hidden.update((id(axis.label), id(axis.offsetText)))
             low, high = sorted(axis.get_view_interval())
             slack = 1e-9 * max(abs(low), abs(high), 1.0)
             for tick in axis.get_major_ticks() + axis.get_minor_ticks():
