@@ -14,7 +14,8 @@ import numpy as np
 
 from uvsym.errors import SimulationError
 
-__all__ = ["SampledLoop", "disturbance_draws", "fault_summary", "logged_signals", "per_sample", "sample_inputs"]
+__all__ = ["SampledLoop", "disturbance_draws", "fault_summary", "logged_signals", "per_sample", "sample_inputs",
+           "varying_rows"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -92,6 +93,17 @@ def sample_inputs(n_w: int, N: int, dt: float, n_noise: int, seed: int) -> np.nd
     W[:, 0] = dt * np.arange(N + 1)
     W[:, 1:1 + n_noise] = np.random.default_rng(seed).standard_normal((N + 1, n_noise))
     return W
+
+
+def varying_rows(N: int, dt: float, n_noise: int, seed: int, blocks=()) -> np.ndarray:
+    """A run's varying input columns (N + 1, 1 + n_noise + the blocks' widths): :func:`sample_inputs`' times and
+    seeded draws, then each block (N + 1, k) of ``blocks`` in order, written in place (no stacked copy)."""
+    rows = sample_inputs(1 + n_noise + sum(block.shape[1] for block in blocks), N, dt, n_noise, seed)
+    first = 1 + n_noise
+    for block in blocks:
+        rows[:, first:first + block.shape[1]] = block
+        first += block.shape[1]
+    return rows
 
 
 def disturbance_draws(N: int, n_d: int, seed: int) -> np.ndarray:

@@ -20,7 +20,7 @@ from uvsym.observers.gains import design_gains
 from uvsym.sim.closed_loop import ClosedLoop, actuator_fault_table, build_closed_loop
 from uvsym.sim.controllers import Autopilot
 from uvsym.sim.inputs import CompactInputs, input_rows
-from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
+from uvsym.sim.loop import fault_summary, per_sample, varying_rows
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.scenario import ObserverSpec, Scenario
@@ -193,13 +193,7 @@ def _run_inputs(loop: ClosedLoop, N: int, dt: float, env: np.ndarray, faults: tu
     touched, values = actuator_fault_table(loop, faults, N)
     blocks.append(values)
     columns.append(loop.fault_columns.start + touched)
-    columns = np.concatenate(columns).astype(np.int_)
-    rows = sample_inputs(columns.size, N, dt, n_noise, seed)  # the other blocks filled in place after t and noise
-    first = 1 + n_noise
-    for block in blocks:
-        rows[:, first:first + block.shape[1]] = block
-        first += block.shape[1]
-    return CompactInputs(constant, columns, rows)
+    return CompactInputs(constant, np.concatenate(columns).astype(np.int_), varying_rows(N, dt, n_noise, seed, blocks))
 
 
 def _attitude_guard(loop):

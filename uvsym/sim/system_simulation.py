@@ -7,7 +7,7 @@ import numpy as np
 from uvsym.errors import SimulationError
 from uvsym.faults import ActuatorFault, SensorFault, fault_parameters
 from uvsym.sim.inputs import CompactInputs
-from uvsym.sim.loop import fault_summary, per_sample, sample_inputs
+from uvsym.sim.loop import fault_summary, per_sample, varying_rows
 from uvsym.sim.result import SimResult
 from uvsym.sim.run import Supervisor, check_memory, grid, memory_needed, run_closed_loop
 from uvsym.sim.step_error import TOLERANCE
@@ -118,15 +118,14 @@ def loop_inputs(loop: WiredLoop, N: int, d=None, seed: int = 0, compact: bool = 
     per_sample(d, plant.d.size, N, "d")
     constant = np.zeros(loop.n_w)
     constant[loop.fault_columns] = [value for fault in loop.faults for value in fault_parameters(fault)]
-    columns = np.arange(1 + n_noise)
+    columns, blocks = [np.arange(1 + n_noise)], []
     if d.ndim == 1:
         constant[start:start + plant.d.size] = d
-        rows = sample_inputs(1 + n_noise, N, loop.dt, n_noise, seed)
-    else:  # d's columns filled in place after the times and the draws
-        columns = np.concatenate([columns, np.arange(start, start + plant.d.size)])
-        rows = sample_inputs(columns.size, N, loop.dt, n_noise, seed)
-        rows[:, 1 + n_noise:] = d
-    inputs = CompactInputs(constant, columns.astype(np.int_), rows)
+    else:
+        blocks.append(d)
+        columns.append(np.arange(start, start + plant.d.size))
+    inputs = CompactInputs(constant, np.concatenate(columns).astype(np.int_),
+                           varying_rows(N, loop.dt, n_noise, seed, blocks))
     return inputs if compact else inputs.dense()
 
 
